@@ -1,0 +1,2 @@
+// narval command line: placeholder until the subcommands land.
+int main() { return 0; }

@@ -1,0 +1,69 @@
+// cl_runtime.h: OpenCL device discovery and selection, context + profiling queue, and program
+// builds from the embedded sources with a persistent binary cache. RAII via the Khronos C++
+// bindings; every failure becomes an exception carrying a clear message (and the build log).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <CL/opencl.hpp>
+
+namespace narval {
+
+struct DeviceInfo {
+  int index = 0;               // position in listDevices(), what --device N refers to
+  std::string platformName, platformVersion;
+  std::string name, vendor, driverVersion, deviceVersion, openclCVersion;
+  std::string type;            // "GPU", "CPU", "accelerator", "other"
+  unsigned computeUnits = 0;
+  size_t globalMemBytes = 0, maxAllocBytes = 0, localMemBytes = 0, constantBufferBytes = 0;
+  size_t maxWorkGroupSize = 0;
+  bool imageSupport = false;
+  size_t image3dMax[3] = {0, 0, 0};
+  bool fp64 = false;
+};
+
+// Every device of every platform, in a stable order (platform, then device).
+std::vector<DeviceInfo> listDevices();
+
+// SPEC: "" -> the first GPU, else the first CPU, else the first device; a number -> that index;
+// otherwise a case-insensitive substring of the device name. Throws InputError when nothing matches
+// (the message lists the devices) or no OpenCL platform exists.
+struct SelectedDevice {
+  cl::Platform platform;
+  cl::Device device;
+  DeviceInfo info;
+};
+SelectedDevice selectDevice(const std::string& spec);
+
+// A context and an in-order queue with profiling enabled on one device.
+struct ClRuntime {
+  SelectedDevice selected;
+  cl::Context context;
+  cl::CommandQueue queue;
+  explicit ClRuntime(const std::string& deviceSpec);
+};
+
+// Thrown when clBuildProgram fails: what() is "OpenCL build of FILE failed:\n<full build log>".
+struct ProgramBuildError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Builds the embedded kernel file `kernelFile` (e.g. "pathtrace.cl") with `options` (-D defines).
+// `sources` defaults to kernelSources(); tests pass their own map. Built binaries are cached in
+// $NARVAL_CACHE_DIR, else $XDG_CACHE_HOME/narval, else ~/.cache/narval, keyed by a hash of the
+// flattened source, the options, platform, device and driver version; NARVAL_CACHE_DIR=off disables it.
+// `cacheHit`, when given, says whether the binary came from the cache.
+cl::Program buildProgram(ClRuntime& rt, const std::string& kernelFile, const std::string& options,
+                         const std::map<std::string, std::string>* sources = nullptr,
+                         bool* cacheHit = nullptr);
+
+// "CL_OUT_OF_RESOURCES (-5)" for an error code.
+std::string clErrorName(int code);
+
+// Human-readable and JSON listings used by `narval devices [--json]`.
+std::string devicesText(const std::vector<DeviceInfo>& devices);
+std::string devicesJson(const std::vector<DeviceInfo>& devices);
+
+}  // namespace narval

@@ -1,0 +1,107 @@
+// scene.h: the scene as loaded from JSON (dissertation Listing 4.1 plus DESIGN.md's extensions).
+// Plain data: validation happens in the loader (scene_load.cpp), which throws narval::InputError.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace narval {
+
+using Vec3f = std::array<float, 3>;
+
+struct Transform {
+  Vec3f position{0, 0, 0};
+  Vec3f scale{1, 1, 1};
+  Vec3f rotation{0, 0, 0};  // degrees, applied X then Y then Z: M = T · Rz · Ry · Rx · S
+};
+
+enum class MaterialType { Emitter, Volume };
+enum class PhaseFunction { Isotropic, HenyeyGreenstein };
+enum class GridSpace { Unit, File };
+
+struct Material {
+  std::string name;
+  MaterialType type = MaterialType::Emitter;
+  Vec3f albedo{0, 0, 0};  // emitter: radiance (rectangle) or intensity W/sr (point)
+  // volume
+  Vec3f scattering{0, 0, 0};
+  Vec3f absorption{0, 0, 0};
+  PhaseFunction phase = PhaseFunction::Isotropic;
+  float g = 0.0f;
+  std::string path;          // resolved against the scene file's folder; empty: homogeneous
+  std::string gridName = "density";
+  float density = 1.0f;      // multiplier D
+  GridSpace gridSpace = GridSpace::Unit;
+};
+
+enum class PrimitiveType { Rectangle, Volume, Point };
+
+struct Primitive {
+  std::string name;
+  PrimitiveType type = PrimitiveType::Volume;
+  Transform transform;
+  std::string materialName;
+  int materialIndex = -1;  // resolved by the loader
+};
+
+struct Camera {
+  Vec3f position{0, 0, -5};
+  Vec3f lookAt{0, 0, 0};
+  Vec3f up{0, 1, 0};
+  float vfov = 45.0f;        // degrees
+  float aperture = 0.0f;     // lens radius, world units (0: pinhole)
+  float focus = 1.0f;        // focus distance, world units
+  float speed = 1.0f;        // viewer navigation only
+};
+
+enum class ToneMapping { None, Reinhard, Aces };
+
+struct RaymarchSettings {
+  int steps = 60;
+  int shadowSteps = 10;
+};
+
+struct LobeSettings {
+  float depthFactor = 20.0f;
+  int lobePoints = 30;
+  float lobeRadius = 1.0f;
+  int shadowSteps = 100;
+};
+
+struct RendererSettings {
+  int width = 1200, height = 600;
+  int spp = 1000;
+  int bounces = 3;
+  bool hdr = true;
+  ToneMapping toneMapping = ToneMapping::Aces;  // JSON true -> Aces, false -> None, or a name
+  float exposure = 0.0f;                        // stops
+  std::string algorithm = "pathtrace";          // pathtrace | raymarch | lobe
+  uint32_t seed = 0;
+  RaymarchSettings raymarch;
+  LobeSettings lobe;
+};
+
+struct Scene {
+  std::string sourcePath;  // the JSON file this came from
+  std::vector<Material> materials;
+  std::vector<Primitive> primitives;
+  Camera camera;
+  RendererSettings renderer;
+  Vec3f background{0, 0, 0};
+  std::vector<std::string> warnings;  // unknown keys and other non-fatal findings
+};
+
+// Loads and validates a scene. `overrides` are "dotted.path=value" strings (--set) applied to the
+// JSON before validation. Throws InputError ("FILE: KEY: what is wrong") on any bad input.
+Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
+// The same from JSON text already in memory; `path` names it in messages and anchors relative paths.
+Scene parseScene(const std::string& jsonText, const std::string& path,
+                 const std::vector<std::string>& overrides = {});
+
+const char* toneMappingName(ToneMapping t);
+
+}  // namespace narval

@@ -1,0 +1,77 @@
+/* structs.h: every struct that crosses host and device, declared once. Fields are 4-byte scalars
+ * or nv_float4 (four floats), padded explicitly to a multiple of 16 bytes, so the layout is the
+ * same in C++ and OpenCL C; tests/device/struct_layout_test.cpp checks every offset on the device. */
+#ifndef NARVAL_STRUCTS_H
+#define NARVAL_STRUCTS_H
+
+#include "shared/vec3.h"
+
+/* Light types (light_params.type). */
+#define LIGHT_RECTANGLE 0
+#define LIGHT_POINT 1
+
+/* Phase function kinds (medium_params.phase). */
+#define PHASE_ISOTROPIC 0
+#define PHASE_HG 1
+
+/* Status word bits: kernels OR these into a global uint; the host reports them. */
+#define STATUS_NAN 1u
+#define STATUS_NEGATIVE_PDF 2u
+#define STATUS_ITERATION_CAP 4u
+
+/* Pinhole or thin-lens camera. Pixel (0,0) is the top-left corner of the image. */
+typedef struct camera_params {
+  nv_float4 position;
+  nv_float4 forward;  /* unit view direction */
+  nv_float4 right;    /* unit, image +x */
+  nv_float4 up;       /* unit, image -y (pixel rows grow downwards) */
+  float tan_half_vfov;
+  float aspect;       /* width / height */
+  float lens_radius;  /* 0: pinhole */
+  float focus_distance;
+  int width;
+  int height;
+  int pad0;
+  int pad1;
+} camera_params;
+
+/* One emitter. Rectangle: corner + s*edge_u + t*edge_v, s,t in [0,1], emitting along `normal`
+ * (one-sided) with radiance `radiance`; normal.w holds the area. Point: `corner` is the position,
+ * `radiance` the intensity in W/sr. */
+typedef struct light_params {
+  nv_float4 corner;
+  nv_float4 edge_u;
+  nv_float4 edge_v;
+  nv_float4 normal;
+  nv_float4 radiance;
+  int type;
+  int pad0;
+  int pad1;
+  int pad2;
+} light_params;
+
+/* The participating medium: an axis-aligned box [0, dims] in grid index space (voxel i covers
+ * [i, i+1], its centre at i + 0.5), reached from world space through one affine map. Coefficients
+ * are per unit density and already include the material's density multiplier D. */
+typedef struct medium_params {
+  nv_affine world_to_index;
+  nv_float4 dims;       /* grid resolution as floats; (1,1,1) for a homogeneous box */
+  nv_float4 sigma_a;    /* absorption · D */
+  nv_float4 sigma_s;    /* scattering · D */
+  float majorant;       /* >= max over the box and channels of sigma_t(x) */
+  float g;              /* Henyey-Greenstein asymmetry */
+  int phase;            /* PHASE_ISOTROPIC or PHASE_HG */
+  int pad0;
+} medium_params;
+
+typedef struct scene_params {
+  camera_params camera;
+  medium_params medium;
+  nv_float4 background;
+  int has_medium;
+  int num_lights;
+  int max_bounces;      /* real scattering events per path */
+  uint seed;
+} scene_params;
+
+#endif
