@@ -73,7 +73,12 @@ int main(int argc, char** argv) {
     std::ifstream old(argv[1]);
     std::stringstream oldText;
     oldText << old.rdbuf();
-    if (oldText.str() != text) std::ofstream(argv[1]) << text;
+    if (oldText.str() != text) {
+      const fs::path out(argv[1]);
+      if (out.has_parent_path()) fs::create_directories(out.parent_path());
+      std::ofstream f(out);
+      if (!(f << text) || !f.flush()) throw std::runtime_error("cannot write " + out.string());
+    }
   } catch (const std::exception& e) {
     std::cerr << "embed_kernels: " << e.what() << "\n";
     return 1;

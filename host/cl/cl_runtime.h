@@ -4,6 +4,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -61,6 +64,13 @@ cl::Program buildProgram(ClRuntime& rt, const std::string& kernelFile, const std
 
 // "CL_OUT_OF_RESOURCES (-5)" for an error code.
 std::string clErrorName(int code);
+// "clCreateContext: CL_DEVICE_NOT_AVAILABLE (-2)" for an exception of the C++ bindings.
+std::string clErrorText(const cl::Error& e);
+
+// The program cache folder (see buildProgram), or "" when NARVAL_CACHE_DIR=off or no home is known.
+std::string programCacheDir();
+// 64-bit FNV-1a of `data`, continuing from `h`: the program cache's key and checksum.
+std::uint64_t fnv1a64(const std::string& data, std::uint64_t h = 14695981039346656037ull);
 
 // Human-readable and JSON listings used by `narval devices [--json]`.
 std::string devicesText(const std::vector<DeviceInfo>& devices);

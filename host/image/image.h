@@ -1,6 +1,7 @@
 // image.h: linear RGB float images, EXR and PNG output, display transform.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -16,12 +17,21 @@ struct ImageRGB {
 };
 
 // 32-bit float linear RGB EXR; `attributes` become string attributes in the header (spp, seed...).
-// Written to a temporary file beside `path` and renamed, so a failure never leaves a broken file.
+// Written to a temporary file beside `path` and renamed, so a failure never leaves a broken file
+// and never touches an existing `path`; it throws std::runtime_error "PATH: cannot write: REASON".
 void writeExr(const std::string& path, const ImageRGB& image,
               const std::vector<std::pair<std::string, std::string>>& attributes = {});
-ImageRGB readExr(const std::string& path);  // throws InputError
+// Reads R, G and B as 32-bit float (half or uint channels are converted) from any data window;
+// the result is the data window's size. A missing, unreadable or corrupt file, or a missing R, G or
+// B channel, throws InputError "PATH: what".
+ImageRGB readExr(const std::string& path);
+// The string attributes of an EXR header (what writeExr's `attributes` put there), by name;
+// throws InputError like readExr.
+std::map<std::string, std::string> readExrAttributes(const std::string& path);
 
-// Display transform: multiply by 2^exposure, tone map, sRGB transfer, 8-bit.
+// Display transform (display_transform.h): multiply by 2^exposure, tone map, clamp to [0, 1],
+// sRGB transfer, round to 8 bit; NaN shows as 0, +inf as 255. RGB8 PNG with an sRGB chunk, written
+// atomically like writeExr. Cannot create or write the file: std::runtime_error naming `path`.
 void writePng(const std::string& path, const ImageRGB& image, float exposureStops, ToneMapping tm);
 
 }  // namespace narval

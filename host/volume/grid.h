@@ -32,9 +32,29 @@ DenseGrid loadVol(const std::string& path);
 // The names of the float grids in a .vdb file (for error messages and `narval info`).
 std::vector<std::string> vdbGridNames(const std::string& path);
 
-// Writes a FloatGrid named `gridName` (zero background, values at or below `tolerance` inactive).
+// Writes a FloatGrid named `gridName` (fog volume, zero background, zeros inactive, uniform voxel
+// size, index (0,0,0) at the origin), atomically (PATH.tmp, then renamed). Throws InputError when the
+// file cannot be written, std::invalid_argument for NaN values or data that does not match the dims.
 void writeVdb(const std::string& path, const DenseGrid& grid, const std::string& gridName = "density",
               float voxelSize = 1.0f);
+
+// Test support (lives in vdb_io.cpp so tests need not include OpenVDB): writes a small .vdb that
+// exercises one loader path. kind: "vec3" (Vec3SGrid "velocity" + FloatGrid "heat"), "frustum"
+// (FloatGrid "density" under a frustum map), "huge" (two active voxels 1024 apart: a 1024^3 box),
+// "empty" (FloatGrid "density" without active voxels), "invalid" (FloatGrid "density", active
+// (0..3, 0, 0) = 1, NaN, -1, +inf), "affine" (voxels (3,4,5)..(4,6,8) holding
+// x + 10y + 100z, transform translate(1,2,3) * rotateZ(30 deg) * scale(2,3,4)).
+void writeVdbTestFile(const std::string& path, const std::string& kind);
+
+// The one rule every loaded grid obeys: densities are finite and >= 0. Sets grid.maxValue; throws
+// InputError "SOURCE: KEY: SUBJECT3 non-finite and 2 negative values (first at voxel X Y Z);
+// densities must be finite and >= 0" when any value breaks it (KEY and SUBJECT may be empty).
+void checkDensityValues(DenseGrid& grid, const std::string& key, const std::string& subject = "");
+
+// The procedural cloud leaves every voxel whose centre lies within this distance of a face of the
+// unit cube (normalised coordinates) at exactly 0: at resolution r that is at least
+// ceil(kCloudMargin * r - 0.5) voxels at each face (1 at r = 8, 5 at r = 64, 20 at r = 256).
+constexpr float kCloudMargin = 0.08f;
 
 // Procedural cumulus-like cloud: noise-displaced blobs with soft edges, density in [0, 1],
 // resolution^3 voxels, deterministic for (resolution, seed).

@@ -10,8 +10,10 @@
 #define NV_GLOBAL __global
 #define NV_CONSTANT __constant
 #define NV_PRIVATE
+/* No contraction into FMA: host and device then round alike, and results do not depend on which
+ * device fuses what. */
+#pragma OPENCL FP_CONTRACT OFF
 typedef float3 vec3;
-typedef uint uint32_t_;
 #define vec3_make(x, y, z) ((float3)((x), (y), (z)))
 #define nv_sqrt sqrt
 #define nv_exp exp

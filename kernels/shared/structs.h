@@ -61,7 +61,7 @@ typedef struct medium_params {
   float majorant;       /* >= max over the box and channels of sigma_t(x) */
   float g;              /* Henyey-Greenstein asymmetry */
   int phase;            /* PHASE_ISOTROPIC or PHASE_HG */
-  int pad0;
+  int grey;             /* 1: sigma_a and sigma_s are equal in all channels (analogue tracking) */
 } medium_params;
 
 typedef struct scene_params {

@@ -1,0 +1,180 @@
+// exr_io.cpp: 32-bit float linear RGB OpenEXR files (DESIGN.md, Output and Platform facts:
+// Imf::RgbaOutputFile writes half only, so this uses Imf::OutputFile with FLOAT slices, which
+// round-trips every float bit-exactly, denormals, negatives, infinities and NaN payloads included).
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+#include <IexBaseExc.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+
+#include "image/atomic_file.h"
+#include "image/image.h"
+#include "scene/input_error.h"
+
+namespace narval {
+namespace {
+
+// Imf output stream over the AtomicFile's FILE*. Imf swallows errors that happen in
+// ~OutputFile (the line offset table is written there), so every error is also kept here and
+// checked once the OutputFile is gone.
+class FileOStream : public Imf::OStream {
+ public:
+  FileOStream(FILE* file, const std::string& name) : Imf::OStream(name.c_str()), file_(file) {}
+  void write(const char c[], int n) override {
+    if (!error_.empty()) throw Iex::IoExc(error_);
+    if (n > 0 && std::fwrite(c, 1, size_t(n), file_) != size_t(n)) failed();
+  }
+  uint64_t tellp() override {
+    const off_t pos = ::ftello(file_);
+    if (pos < 0) failed();
+    return uint64_t(pos);
+  }
+  void seekp(uint64_t pos) override {
+    if (!error_.empty()) throw Iex::IoExc(error_);
+    if (::fseeko(file_, off_t(pos), SEEK_SET) != 0) failed();
+  }
+  const std::string& error() const { return error_; }
+
+ private:
+  [[noreturn]] void failed() {
+    error_ = std::strerror(errno ? errno : EIO);
+    throw Iex::IoExc(error_);
+  }
+  FILE* file_;
+  std::string error_;
+};
+
+std::string oneLine(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+
+// Opens an EXR for reading; every failure is an InputError "PATH: what".
+std::unique_ptr<Imf::InputFile> openExr(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw inputError(path, "", "file not found");
+  if (std::filesystem::is_directory(status)) throw inputError(path, "", "is a directory, not an EXR file");
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw inputError(path, "", std::string("cannot open: ") + std::strerror(errno));
+    unsigned char magic[4] = {0, 0, 0, 0};
+    in.read(reinterpret_cast<char*>(magic), 4);
+    // OpenEXR magic number 20000630, little endian (OpenEXR file layout, "Magic Number").
+    if (in.gcount() != 4 || magic[0] != 0x76 || magic[1] != 0x2f || magic[2] != 0x31 || magic[3] != 0x01)
+      throw inputError(path, "", "not an OpenEXR file");
+  }
+  try {
+    return std::make_unique<Imf::InputFile>(path.c_str());
+  } catch (const std::exception& e) {
+    throw inputError(path, "", "corrupt OpenEXR file: " + oneLine(e.what()));
+  }
+}
+
+}  // namespace
+
+void writeExr(const std::string& path, const ImageRGB& image,
+              const std::vector<std::pair<std::string, std::string>>& attributes) {
+  if (image.width <= 0 || image.height <= 0)
+    throw std::runtime_error(writeErrorMessage(path, "empty image (" + std::to_string(image.width) + "x" +
+                                                         std::to_string(image.height) + ")"));
+  if (image.rgb.size() != size_t(image.width) * size_t(image.height) * 3)
+    throw std::runtime_error(writeErrorMessage(path, "pixel buffer size does not match the image size"));
+
+  Imf::Header header(image.width, image.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  header.channels().insert("R", Imf::Channel(Imf::FLOAT));
+  header.channels().insert("G", Imf::Channel(Imf::FLOAT));
+  header.channels().insert("B", Imf::Channel(Imf::FLOAT));
+  for (const auto& [name, value] : attributes) {
+    try {
+      header.insert(name, Imf::StringAttribute(value));
+    } catch (const std::exception& e) {
+      throw std::runtime_error(writeErrorMessage(path, "attribute \"" + name + "\": " + oneLine(e.what())));
+    }
+  }
+
+  AtomicFile out(path);
+  FileOStream stream(out.file(), path);
+  try {
+    Imf::OutputFile file(stream, header);
+    const size_t xStride = 3 * sizeof(float);
+    const size_t yStride = xStride * size_t(image.width);
+    char* base = const_cast<char*>(reinterpret_cast<const char*>(image.rgb.data()));
+    Imf::FrameBuffer frame;
+    frame.insert("R", Imf::Slice(Imf::FLOAT, base + 0 * sizeof(float), xStride, yStride));
+    frame.insert("G", Imf::Slice(Imf::FLOAT, base + 1 * sizeof(float), xStride, yStride));
+    frame.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xStride, yStride));
+    file.setFrameBuffer(frame);
+    file.writePixels(image.height);
+  } catch (const std::exception& e) {
+    out.fail(stream.error().empty() ? oneLine(e.what()) : stream.error());
+  }
+  if (!stream.error().empty()) out.fail(stream.error());  // from ~OutputFile, which swallows it
+  out.commit();
+}
+
+ImageRGB readExr(const std::string& path) {
+  auto file = openExr(path);
+  const Imf::Header& header = file->header();
+  for (const char* name : {"R", "G", "B"}) {
+    if (!header.channels().findChannel(name)) {
+      std::string found;
+      for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+        found += (found.empty() ? "" : ", ") + std::string(it.name());
+      throw inputError(path, "", std::string("no ") + name + " channel (channels: " +
+                                     (found.empty() ? "none" : found) + ")");
+    }
+  }
+  const Imath::Box2i window = header.dataWindow();
+  const int64_t width = int64_t(window.max.x) - window.min.x + 1;
+  const int64_t height = int64_t(window.max.y) - window.min.y + 1;
+  if (width <= 0 || height <= 0) throw inputError(path, "", "empty data window");
+  if (width * height > (int64_t(1) << 28))
+    throw inputError(path, "", "image too large (" + std::to_string(width) + "x" + std::to_string(height) + ")");
+
+  ImageRGB image;
+  image.width = int(width);
+  image.height = int(height);
+  image.rgb.assign(size_t(width * height) * 3, 0.0f);
+  const size_t xStride = 3 * sizeof(float);
+  const size_t yStride = xStride * size_t(width);
+  char* base = reinterpret_cast<char*>(image.rgb.data());
+  Imf::FrameBuffer frame;
+  // Slice::Make offsets the base pointer by the data window origin without overflow.
+  frame.insert("R", Imf::Slice::Make(Imf::FLOAT, base + 0 * sizeof(float), window, xStride, yStride));
+  frame.insert("G", Imf::Slice::Make(Imf::FLOAT, base + 1 * sizeof(float), window, xStride, yStride));
+  frame.insert("B", Imf::Slice::Make(Imf::FLOAT, base + 2 * sizeof(float), window, xStride, yStride));
+  try {
+    file->setFrameBuffer(frame);
+    file->readPixels(window.min.y, window.max.y);
+  } catch (const std::exception& e) {
+    throw inputError(path, "", "corrupt OpenEXR file: " + oneLine(e.what()));
+  }
+  return image;
+}
+
+std::map<std::string, std::string> readExrAttributes(const std::string& path) {
+  auto file = openExr(path);
+  std::map<std::string, std::string> result;
+  const Imf::Header& header = file->header();
+  for (auto it = header.begin(); it != header.end(); ++it) {
+    if (std::strcmp(it.attribute().typeName(), Imf::StringAttribute::staticTypeName()) == 0)
+      result[it.name()] = static_cast<const Imf::StringAttribute&>(it.attribute()).value();
+  }
+  return result;
+}
+
+}  // namespace narval

@@ -1,0 +1,215 @@
+#include "render/scene_upload.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "scene/input_error.h"
+
+namespace narval {
+namespace {
+
+constexpr float kDegToRad = 3.14159265358979323846f / 180.0f;
+
+nv_float4 f4(float x, float y, float z, float w = 0.0f) { return nv_float4{x, y, z, w}; }
+nv_float4 f4(const Vec3f& v, float w = 0.0f) { return nv_float4{v[0], v[1], v[2], w}; }
+
+struct V3 {
+  float x, y, z;
+};
+V3 sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+float dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V3 normalize(V3 a) {
+  const float l = std::sqrt(dot(a, a));
+  return {a.x / l, a.y / l, a.z / l};
+}
+V3 v3(const Vec3f& v) { return {v[0], v[1], v[2]}; }
+V3 apply(const nv_affine& m, V3 p, float w) {
+  const nv_float4* r = m.row;
+  return {r[0].x * p.x + r[0].y * p.y + r[0].z * p.z + r[0].w * w,
+          r[1].x * p.x + r[1].y * p.y + r[1].z * p.z + r[1].w * w,
+          r[2].x * p.x + r[2].y * p.y + r[2].z * p.z + r[2].w * w};
+}
+
+nv_affine fromRows(const float m[3][4]) {
+  nv_affine a;
+  for (int i = 0; i < 3; ++i) a.row[i] = f4(m[i][0], m[i][1], m[i][2], m[i][3]);
+  return a;
+}
+
+nv_affine rotationOnly(const Transform& t) {
+  Transform r;
+  r.rotation = t.rotation;
+  return transformMatrix(r);
+}
+
+camera_params buildCamera(const Scene& scene) {
+  const Camera& c = scene.camera;
+  camera_params cam{};
+  const V3 pos = v3(c.position);
+  const V3 fwd = normalize(sub(v3(c.lookAt), pos));
+  const V3 right = normalize(cross(fwd, v3(c.up)));
+  const V3 up = cross(right, fwd);
+  cam.position = f4(pos.x, pos.y, pos.z);
+  cam.forward = f4(fwd.x, fwd.y, fwd.z);
+  cam.right = f4(right.x, right.y, right.z);
+  cam.up = f4(up.x, up.y, up.z);
+  cam.width = scene.renderer.width;
+  cam.height = scene.renderer.height;
+  cam.aspect = float(cam.width) / float(cam.height);
+  cam.tan_half_vfov = std::tan(0.5f * c.vfov * kDegToRad);
+  cam.lens_radius = c.aperture;
+  cam.focus_distance = c.focus;
+  return cam;
+}
+
+light_params buildLight(const Primitive& p, const Material& m) {
+  light_params l{};
+  l.radiance = f4(m.albedo);
+  if (p.type == PrimitiveType::Point) {
+    l.type = LIGHT_POINT;
+    l.corner = f4(p.transform.position);
+    return l;
+  }
+  // The unit quad [-0.5, 0.5]² in local XY, emitting along local -Z (DESIGN.md, emitters). The
+  // emission direction follows the rotation alone: scale changes the extent, not the facing.
+  const nv_affine M = transformMatrix(p.transform);
+  const V3 corner = apply(M, {-0.5f, -0.5f, 0.0f}, 1.0f);
+  const V3 eu = apply(M, {1, 0, 0}, 0.0f), ev = apply(M, {0, 1, 0}, 0.0f);
+  const V3 n = normalize(apply(rotationOnly(p.transform), {0, 0, -1}, 0.0f));
+  const V3 area = cross(eu, ev);
+  l.type = LIGHT_RECTANGLE;
+  l.corner = f4(corner.x, corner.y, corner.z);
+  l.edge_u = f4(eu.x, eu.y, eu.z);
+  l.edge_v = f4(ev.x, ev.y, ev.z);
+  l.normal = f4(n.x, n.y, n.z, std::sqrt(dot(area, area)));
+  return l;
+}
+
+}  // namespace
+
+nv_affine transformMatrix(const Transform& t) {
+  const float ax = t.rotation[0] * kDegToRad, ay = t.rotation[1] * kDegToRad, az = t.rotation[2] * kDegToRad;
+  const float cx = std::cos(ax), sx = std::sin(ax), cy = std::cos(ay), sy = std::sin(ay);
+  const float cz = std::cos(az), sz = std::sin(az);
+  // R = Rz · Ry · Rx
+  const float R[3][3] = {{cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
+                         {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
+                         {-sy, cy * sx, cy * cx}};
+  float m[3][4];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m[i][j] = R[i][j] * t.scale[j];
+    m[i][3] = t.position[i];
+  }
+  return fromRows(m);
+}
+
+nv_affine affineMultiply(const nv_affine& a, const nv_affine& b) {
+  auto get = [](const nv_affine& m, int i, int j) {
+    const nv_float4& r = m.row[i];
+    return j == 0 ? r.x : j == 1 ? r.y : j == 2 ? r.z : r.w;
+  };
+  float m[3][4];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) {
+      double s = j == 3 ? get(a, i, 3) : 0.0;
+      for (int k = 0; k < 3; ++k) s += double(get(a, i, k)) * get(b, k, j);
+      m[i][j] = float(s);
+    }
+  return fromRows(m);
+}
+
+nv_affine affineInverse(const nv_affine& a) {
+  const nv_float4* r = a.row;
+  const double m[3][3] = {{r[0].x, r[0].y, r[0].z}, {r[1].x, r[1].y, r[1].z}, {r[2].x, r[2].y, r[2].z}};
+  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  if (!(std::fabs(det) > 1e-30) || !std::isfinite(det)) throw std::domain_error("singular transform");
+  double inv[3][3];
+  inv[0][0] = (m[1][1] * m[2][2] - m[1][2] * m[2][1]) / det;
+  inv[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det;
+  inv[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det;
+  inv[1][0] = (m[1][2] * m[2][0] - m[1][0] * m[2][2]) / det;
+  inv[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det;
+  inv[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det;
+  inv[2][0] = (m[1][0] * m[2][1] - m[1][1] * m[2][0]) / det;
+  inv[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det;
+  inv[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det;
+  const double t[3] = {r[0].w, r[1].w, r[2].w};
+  float out[3][4];
+  for (int i = 0; i < 3; ++i) {
+    double s = 0;
+    for (int j = 0; j < 3; ++j) {
+      out[i][j] = float(inv[i][j]);
+      s -= inv[i][j] * t[j];
+    }
+    out[i][3] = float(s);
+  }
+  return fromRows(out);
+}
+
+DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
+  DeviceScene ds;
+  scene_params& sp = ds.params;
+  sp.camera = buildCamera(scene);
+  sp.background = f4(scene.background);
+  sp.max_bounces = scene.renderer.bounces;
+  sp.seed = scene.renderer.seed;
+  for (size_t i = 0; i < scene.primitives.size(); ++i) {
+    const Primitive& p = scene.primitives[i];
+    const Material& m = scene.materials.at(size_t(p.materialIndex));
+    if (p.type != PrimitiveType::Volume) {
+      ds.lights.push_back(buildLight(p, m));
+      continue;
+    }
+    medium_params& med = sp.medium;
+    sp.has_medium = 1;
+    const float D = m.density;
+    med.sigma_a = f4(m.absorption[0] * D, m.absorption[1] * D, m.absorption[2] * D);
+    med.sigma_s = f4(m.scattering[0] * D, m.scattering[1] * D, m.scattering[2] * D);
+    med.phase = m.phase == PhaseFunction::HenyeyGreenstein ? PHASE_HG : PHASE_ISOTROPIC;
+    med.g = med.phase == PHASE_HG ? m.g : 0.0f;
+    med.grey = m.absorption[0] == m.absorption[1] && m.absorption[1] == m.absorption[2] &&
+               m.scattering[0] == m.scattering[1] && m.scattering[1] == m.scattering[2];
+    float maxSigmaT = 0.0f;
+    for (int c = 0; c < 3; ++c) maxSigmaT = std::max(maxSigmaT, (m.absorption[c] + m.scattering[c]) * D);
+    const float maxDensity = grid ? grid->maxValue : 1.0f;
+    // Trilinear values never exceed the largest voxel; the margin absorbs float rounding so that
+    // 1 - σt/σ̄ never goes negative.
+    med.majorant = maxSigmaT * maxDensity * (1.0f + 1e-5f);
+    const float dims[3] = {grid ? float(grid->nx) : 1.0f, grid ? float(grid->ny) : 1.0f,
+                           grid ? float(grid->nz) : 1.0f};
+    med.dims = f4(dims[0], dims[1], dims[2]);
+    const std::string key = "primitives[" + std::to_string(i) + "].transform";
+    // index -> world: "unit" maps the grid's box onto the primitive's unit cube; "file" keeps
+    // the grid's own index-to-world map and applies the primitive transform on top.
+    nv_affine indexToWorld;
+    if (grid && m.gridSpace == GridSpace::File) {
+      float f[3][4];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) f[r][c] = grid->indexToWorld[size_t(r * 4 + c)];
+      indexToWorld = affineMultiply(transformMatrix(p.transform), fromRows(f));
+    } else {
+      const float u[3][4] = {{1 / dims[0], 0, 0, -0.5f}, {0, 1 / dims[1], 0, -0.5f}, {0, 0, 1 / dims[2], -0.5f}};
+      indexToWorld = affineMultiply(transformMatrix(p.transform), fromRows(u));
+      if (grid && !grid->fileTransformIsScaleTranslate)
+        ds.warnings.push_back(scene.sourcePath + ": " + "materials[" + std::to_string(p.materialIndex) +
+                              "].gridSpace: the grid's file transform rotates or shears; \"unit\" grid space "
+                              "drops it (set \"gridSpace\": \"file\" to keep it)");
+    }
+    try {
+      med.world_to_index = affineInverse(indexToWorld);
+    } catch (const std::domain_error&) {
+      throw inputError(scene.sourcePath, key, "the volume's transform is singular (a zero scale?)");
+    }
+    ds.grid = grid;
+  }
+  sp.num_lights = int(ds.lights.size());
+  if (ds.lights.empty()) ds.lights.push_back(light_params{});  // a buffer may not be empty
+  ds.buildOptions = (!sp.has_medium || !grid) ? "-DMEDIUM_HOMOGENEOUS" : "";
+  return ds;
+}
+
+}  // namespace narval

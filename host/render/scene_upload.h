@@ -1,0 +1,33 @@
+// scene_upload.h: turns a validated Scene (and its loaded grid) into the structs the kernels read
+// (kernels/shared/structs.h) and the -D options that specialise the kernel for it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "shared/structs.h"
+#include "scene/scene.h"
+#include "volume/grid.h"
+
+namespace narval {
+
+struct DeviceScene {
+  scene_params params{};
+  std::vector<light_params> lights;
+  const DenseGrid* grid = nullptr;  // null: homogeneous medium or none
+  std::string buildOptions;         // -D defines for this scene
+  std::vector<std::string> warnings;
+};
+
+// The primitive transform M = T · Rz · Ry · Rx · S (rotation in degrees, X applied first) as a
+// row-major 3x4 matrix.
+nv_affine transformMatrix(const Transform& t);
+nv_affine affineMultiply(const nv_affine& a, const nv_affine& b);
+// Throws std::domain_error for a singular map.
+nv_affine affineInverse(const nv_affine& m);
+
+// `grid` must be the volume's loaded grid (or null for a homogeneous medium / no volume).
+// Throws InputError for geometry the renderer cannot use (a singular volume transform).
+DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid);
+
+}  // namespace narval

@@ -1,0 +1,159 @@
+// json_reader.cpp: see json_reader.h.
+#include "scene/json_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+
+namespace narval::scene_detail {
+
+void JsonContext::fail(const std::string& key, const std::string& what) const {
+  throw inputError(file, key, what);
+}
+
+void JsonContext::warn(const std::string& key, const std::string& what) const {
+  warnings->push_back(inputError(file, key, what).what());
+}
+
+std::string childKey(const std::string& parent, const std::string& name) {
+  return parent.empty() ? name : parent + "." + name;
+}
+
+std::string indexKey(const std::string& parent, size_t index) {
+  return parent + "[" + std::to_string(index) + "]";
+}
+
+std::string formatNumber(float v) {
+  // Whole numbers as written (180, not 1.8e+02); others in the fewest digits that read back.
+  if (v == std::floor(v) && std::fabs(v) < 1e9f) return std::to_string(static_cast<long long>(v));
+  char buf[32];
+  for (int precision = 1; precision <= 9; ++precision) {
+    std::snprintf(buf, sizeof buf, "%.*g", precision, static_cast<double>(v));
+    if (static_cast<float>(std::strtod(buf, nullptr)) == v) break;
+  }
+  return buf;
+}
+
+namespace {
+
+std::string got(const json& v) { return std::string("got ") + v.type_name(); }
+
+}  // namespace
+
+float toFloat(const JsonContext& ctx, const json& v, const std::string& key) {
+  if (!v.is_number()) ctx.fail(key, "expected a number, " + got(v));
+  const float f = static_cast<float>(v.get<double>());
+  // JSON itself cannot say NaN or inf, but 1e39 overflows the renderer's floats.
+  if (!std::isfinite(f)) ctx.fail(key, "must be finite as a 32-bit float, got " + v.dump());
+  return f;
+}
+
+int64_t toInteger(const JsonContext& ctx, const json& v, const std::string& key) {
+  if (v.is_number_unsigned()) {
+    if (v.get<uint64_t>() > static_cast<uint64_t>(std::numeric_limits<int64_t>::max()))
+      ctx.fail(key, "integer out of range, got " + v.dump());
+    return static_cast<int64_t>(v.get<uint64_t>());
+  }
+  if (v.is_number_integer()) return v.get<int64_t>();
+  if (v.is_number_float()) {
+    // 16.0 is an integer to a user; 16.5 is not.
+    const double d = v.get<double>();
+    if (d != std::floor(d)) ctx.fail(key, "expected an integer, got " + v.dump());
+    if (std::fabs(d) >= 9.2e18) ctx.fail(key, "integer out of range, got " + v.dump());
+    return static_cast<int64_t>(d);
+  }
+  ctx.fail(key, "expected an integer, " + got(v));
+}
+
+bool toBool(const JsonContext& ctx, const json& v, const std::string& key) {
+  if (!v.is_boolean()) ctx.fail(key, "expected a boolean, " + got(v));
+  return v.get<bool>();
+}
+
+std::string toString(const JsonContext& ctx, const json& v, const std::string& key) {
+  if (!v.is_string()) ctx.fail(key, "expected a string, " + got(v));
+  return v.get<std::string>();
+}
+
+Vec3f toVec3(const JsonContext& ctx, const json& v, const std::string& key) {
+  if (!v.is_array()) ctx.fail(key, "expected an array of 3 numbers, " + got(v));
+  if (v.size() != 3)
+    ctx.fail(key, "expected an array of 3 numbers, got " + std::to_string(v.size()) + " elements");
+  Vec3f out;
+  for (size_t i = 0; i < 3; ++i) out[i] = toFloat(ctx, v[i], indexKey(key, i));
+  return out;
+}
+
+const json& toArray(const JsonContext& ctx, const json& v, const std::string& key) {
+  if (!v.is_array()) ctx.fail(key, "expected an array, " + got(v));
+  return v;
+}
+
+ObjectReader::ObjectReader(JsonContext& ctx, const json& value, std::string key)
+    : ctx_(ctx), value_(value), key_(std::move(key)) {
+  if (!value_.is_object()) ctx_.fail(key_, "expected an object, " + got(value_));
+}
+
+bool ObjectReader::has(const std::string& name) const { return value_.contains(name); }
+
+const json* ObjectReader::find(const std::string& name) {
+  known_.push_back(name);
+  const auto it = value_.find(name);
+  return it == value_.end() ? nullptr : &*it;
+}
+
+const json& ObjectReader::require(const std::string& name) {
+  const json* v = find(name);
+  if (!v) ctx_.fail(keyOf(name), "missing required key");
+  return *v;
+}
+
+float ObjectReader::getFloat(const std::string& name, float fallback) {
+  const json* v = find(name);
+  return v ? toFloat(ctx_, *v, keyOf(name)) : fallback;
+}
+
+float ObjectReader::requireFloat(const std::string& name) {
+  return toFloat(ctx_, require(name), keyOf(name));
+}
+
+int64_t ObjectReader::getInteger(const std::string& name, int64_t fallback) {
+  const json* v = find(name);
+  return v ? toInteger(ctx_, *v, keyOf(name)) : fallback;
+}
+
+bool ObjectReader::getBool(const std::string& name, bool fallback) {
+  const json* v = find(name);
+  return v ? toBool(ctx_, *v, keyOf(name)) : fallback;
+}
+
+std::string ObjectReader::getString(const std::string& name, const std::string& fallback) {
+  const json* v = find(name);
+  return v ? toString(ctx_, *v, keyOf(name)) : fallback;
+}
+
+std::string ObjectReader::requireString(const std::string& name) {
+  return toString(ctx_, require(name), keyOf(name));
+}
+
+Vec3f ObjectReader::getVec3(const std::string& name, const Vec3f& fallback) {
+  const json* v = find(name);
+  return v ? toVec3(ctx_, *v, keyOf(name)) : fallback;
+}
+
+Vec3f ObjectReader::requireVec3(const std::string& name) {
+  return toVec3(ctx_, require(name), keyOf(name));
+}
+
+void ObjectReader::reportUnknown() {
+  for (const auto& item : value_.items()) {
+    if (std::find(known_.begin(), known_.end(), item.key()) != known_.end()) continue;
+    const std::string key = keyOf(item.key());
+    ctx_.unknownKeys.push_back(key);
+    ctx_.warnings->push_back(ctx_.file + ": unknown key " + key + " (ignored)");
+  }
+}
+
+}  // namespace narval::scene_detail

@@ -1,0 +1,77 @@
+// json_reader.h: typed, key-path-aware reading of a JSON document for the scene loader.
+// Every failure becomes one InputError line "FILE: KEY: what", KEY a dotted path such as
+// materials[1].g, so a user can find the offending value without reading a stack trace.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/input_error.h"
+#include "scene/scene.h"
+
+namespace narval::scene_detail {
+
+using json = nlohmann::json;
+
+// Where messages go while one scene is read.
+struct JsonContext {
+  std::string file;                      // the scene file's name as the user gave it
+  std::vector<std::string>* warnings;    // Scene::warnings
+  std::vector<std::string> unknownKeys;  // dotted paths of keys the schema did not ask for
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+  void warn(const std::string& key, const std::string& what) const;
+};
+
+std::string childKey(const std::string& parent, const std::string& name);  // "a" + "b" -> "a.b"
+std::string indexKey(const std::string& parent, size_t index);             // "a" + 1 -> "a[1]"
+
+// A float as the messages print it: the shortest form that reads back (1.5, 0.0001, 1e+20).
+std::string formatNumber(float v);
+
+// Conversions of one value; `key` names it in messages.
+float toFloat(const JsonContext& ctx, const json& v, const std::string& key);         // finite
+int64_t toInteger(const JsonContext& ctx, const json& v, const std::string& key);     // integral
+bool toBool(const JsonContext& ctx, const json& v, const std::string& key);
+std::string toString(const JsonContext& ctx, const json& v, const std::string& key);
+Vec3f toVec3(const JsonContext& ctx, const json& v, const std::string& key);          // exactly 3
+const json& toArray(const JsonContext& ctx, const json& v, const std::string& key);
+
+// One JSON object being read. Remembers which keys the schema asked for so that reportUnknown()
+// can warn about the rest (typos such as "fov" must not pass silently).
+class ObjectReader {
+ public:
+  // Fails with "KEY: expected an object, got T" unless `value` is an object.
+  ObjectReader(JsonContext& ctx, const json& value, std::string key);
+
+  const std::string& key() const { return key_; }
+  std::string keyOf(const std::string& name) const { return childKey(key_, name); }
+  JsonContext& context() const { return ctx_; }
+
+  bool has(const std::string& name) const;
+  const json* find(const std::string& name);     // nullptr when absent; marks the key as known
+  const json& require(const std::string& name);  // "KEY: missing required key" when absent
+
+  float getFloat(const std::string& name, float fallback);
+  float requireFloat(const std::string& name);
+  int64_t getInteger(const std::string& name, int64_t fallback);
+  bool getBool(const std::string& name, bool fallback);
+  std::string getString(const std::string& name, const std::string& fallback);
+  std::string requireString(const std::string& name);
+  Vec3f getVec3(const std::string& name, const Vec3f& fallback);
+  Vec3f requireVec3(const std::string& name);
+
+  // Adds "FILE: unknown key KEY (ignored)" for every key never looked up.
+  void reportUnknown();
+
+ private:
+  JsonContext& ctx_;
+  const json& value_;
+  std::string key_;
+  std::vector<std::string> known_;
+};
+
+}  // namespace narval::scene_detail

@@ -1,0 +1,425 @@
+// scene_load.cpp: the scene file (dissertation Listing 4.1 plus DESIGN.md's extensions) read into
+// narval::Scene, validated so that nothing the renderer cannot honour gets past this file.
+//
+// Parameters. "req" = required; every other key may be left out and takes the default shown
+// (scene.h holds the same defaults). Vectors are arrays of exactly 3 finite numbers.
+//
+// | key                     | type                            | req | default     | constraint                 |
+// |-------------------------|---------------------------------|-----|-------------|----------------------------|
+// | materials               | array of objects                | req |             |                            |
+// |   [i].name              | string                          | req |             | non-empty, unique          |
+// |   [i].type              | emitter, volume                 | req |             |                            |
+// |   emitter: albedo       | vec3: radiance (point: W/sr)    | req |             | >= 0                       |
+// |   volume: scattering    | vec3, per world unit            | req |             | >= 0                       |
+// |   volume: absorption    | vec3, per world unit            | req |             | >= 0                       |
+// |   volume: phaseFunction | isotropic, hg                   |     | isotropic   |                            |
+// |   volume: g             | number                          |     | 0           | [-1, 1]; ±1 -> ±0.9999     |
+// |   volume: path          | string: .vdb or .vol file       |     | homogeneous | exists; ${VAR}, ${VAR:-d}; |
+// |                         |                                 |     |             | relative to the scene file |
+// |   volume: density       | number: multiplier D            |     | 1           | >= 0                       |
+// |   volume: grid          | string: grid name in the .vdb   |     | density     | non-empty                  |
+// |   volume: gridSpace     | unit, file                      |     | unit        |                            |
+// | primitives              | array of objects                | req |             | at most one volume         |
+// |   [i].name              | string                          |     | ""          |                            |
+// |   [i].type              | rectangle, volume, point        | req |             |                            |
+// |   [i].transform         | object                          |     | identity    |                            |
+// |     .position           | vec3                            |     | [0, 0, 0]   |                            |
+// |     .scale              | vec3                            |     | [1, 1, 1]   | non-zero (volume: x, y, z; |
+// |                         |                                 |     |             | rectangle: x, y)           |
+// |     .rotation           | vec3, degrees                   |     | [0, 0, 0]   |                            |
+// |   [i].materialName      | string                          | req |             | a material of the matching |
+// |                         |                                 |     |             | type: volume for volume,   |
+// |                         |                                 |     |             | emitter for rectangle/point|
+// | camera                  | object                          | req |             |                            |
+// |   position              | vec3                            | req |             |                            |
+// |   lookAt                | vec3                            | req |             | != position                |
+// |   up                    | vec3                            |     | [0, 1, 0]   | not parallel to the view   |
+// |   vfov                  | number, degrees                 |     | 45          | (0, 180)                   |
+// |   aperture              | number: lens radius             |     | 0           | >= 0                       |
+// |   focus                 | number: focus distance          |     | 1           | > 0                        |
+// |   speed                 | number: viewer navigation       |     | 1           | >= 0                       |
+// | renderer                | object                          | req |             |                            |
+// |   resolution            | [width, height] integers        | req |             | each in [1, 16384]         |
+// |   spp                   | integer                         |     | 1000        | >= 1                       |
+// |   bounces               | integer                         |     | 3           | >= 0                       |
+// |   HDR                   | boolean                         |     | true        |                            |
+// |   toneMapping           | bool, or none, reinhard, aces   |     | true        | true = aces, false = none  |
+// |   exposure              | number, stops                   |     | 0           |                            |
+// |   algorithm             | pathtrace, raymarch, lobe       |     | pathtrace   |                            |
+// |   seed                  | integer                         |     | 0           | [0, 2^32 - 1]              |
+// |   raymarch.steps        | integer                         |     | 60          | >= 1                       |
+// |   raymarch.shadowSteps  | integer                         |     | 10          | >= 1                       |
+// |   lobe.depthFactor      | number                          |     | 20          | >= 0                       |
+// |   lobe.lobePoints       | integer                         |     | 30          | >= 1                       |
+// |   lobe.lobeRadius       | number, world units             |     | 1           | >= 0                       |
+// |   lobe.shadowSteps      | integer                         |     | 100         | >= 1                       |
+// | background              | vec3: radiance of escaping rays |     | [0, 0, 0]   | >= 0                       |
+//
+// Unknown keys (anywhere, including keys of the other material type) are warnings, never errors,
+// except under --set, where a key the loader does not know is a typo and fails.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <utility>
+
+#include "scene/input_error.h"
+#include "scene/json_override.h"
+#include "scene/json_reader.h"
+#include "scene/scene.h"
+#include "scene/scene_path.h"
+
+namespace narval {
+
+using namespace scene_detail;
+
+namespace {
+
+constexpr int64_t kIntMax = std::numeric_limits<int>::max();
+constexpr int64_t kMaxImageSide = 16384;  // keeps width * height well inside an int
+
+template <typename E>
+using EnumNames = std::vector<std::pair<const char*, E>>;
+
+template <typename E>
+std::string allowedList(const EnumNames<E>& names) {
+  std::string out;
+  for (const auto& [name, value] : names) out += (out.empty() ? "" : ", ") + std::string(name);
+  return out;
+}
+
+template <typename E>
+E toEnum(const JsonContext& ctx, const json& v, const std::string& key, const EnumNames<E>& names) {
+  const std::string s = toString(ctx, v, key);
+  for (const auto& [name, value] : names)
+    if (s == name) return value;
+  ctx.fail(key, "unknown value \"" + s + "\" (allowed: " + allowedList(names) + ")");
+}
+
+template <typename E>
+E readEnum(ObjectReader& r, const std::string& name, const EnumNames<E>& names, E fallback) {
+  const json* v = r.find(name);
+  return v ? toEnum(r.context(), *v, r.keyOf(name), names) : fallback;
+}
+
+template <typename E>
+E requireEnum(ObjectReader& r, const std::string& name, const EnumNames<E>& names) {
+  return toEnum(r.context(), r.require(name), r.keyOf(name), names);
+}
+
+const EnumNames<MaterialType> kMaterialTypes = {{"emitter", MaterialType::Emitter},
+                                                {"volume", MaterialType::Volume}};
+const EnumNames<PhaseFunction> kPhaseFunctions = {{"isotropic", PhaseFunction::Isotropic},
+                                                  {"hg", PhaseFunction::HenyeyGreenstein}};
+const EnumNames<GridSpace> kGridSpaces = {{"unit", GridSpace::Unit}, {"file", GridSpace::File}};
+const EnumNames<PrimitiveType> kPrimitiveTypes = {{"rectangle", PrimitiveType::Rectangle},
+                                                  {"volume", PrimitiveType::Volume},
+                                                  {"point", PrimitiveType::Point}};
+const EnumNames<ToneMapping> kToneMappings = {{"none", ToneMapping::None},
+                                              {"reinhard", ToneMapping::Reinhard},
+                                              {"aces", ToneMapping::Aces}};
+const EnumNames<std::string> kAlgorithms = {{"pathtrace", "pathtrace"},
+                                            {"raymarch", "raymarch"},
+                                            {"lobe", "lobe"}};
+
+const char* materialTypeName(MaterialType t) { return t == MaterialType::Emitter ? "emitter" : "volume"; }
+const char* primitiveTypeName(PrimitiveType t) {
+  return t == PrimitiveType::Rectangle ? "rectangle" : t == PrimitiveType::Volume ? "volume" : "point";
+}
+
+// --- range checks: the message names the value as the user wrote it ---
+
+void checkNonNegative(const JsonContext& ctx, const std::string& key, float v) {
+  if (!(v >= 0)) ctx.fail(key, "must be non-negative, got " + formatNumber(v));
+}
+
+void checkNonNegative(const JsonContext& ctx, const std::string& key, const Vec3f& v) {
+  for (size_t i = 0; i < 3; ++i) checkNonNegative(ctx, indexKey(key, i), v[i]);
+}
+
+int64_t checkIntRange(const JsonContext& ctx, const std::string& key, int64_t v, int64_t lo, int64_t hi) {
+  if (v < lo) ctx.fail(key, "must be at least " + std::to_string(lo) + ", got " + std::to_string(v));
+  if (v > hi) ctx.fail(key, "must be at most " + std::to_string(hi) + ", got " + std::to_string(v));
+  return v;
+}
+
+int readInt(ObjectReader& r, const std::string& name, int fallback, int64_t lo, int64_t hi = kIntMax) {
+  return static_cast<int>(checkIntRange(r.context(), r.keyOf(name), r.getInteger(name, fallback), lo, hi));
+}
+
+float readNonNegative(ObjectReader& r, const std::string& name, float fallback) {
+  const float v = r.getFloat(name, fallback);
+  checkNonNegative(r.context(), r.keyOf(name), v);
+  return v;
+}
+
+// --- sections ---
+
+void readHenyeyGreensteinG(ObjectReader& r, Material& m) {
+  const json* v = r.find("g");
+  if (!v) return;
+  const std::string key = r.keyOf("g");
+  m.g = toFloat(r.context(), *v, key);
+  if (!(std::fabs(m.g) <= 1)) r.context().fail(key, "must be in [-1, 1], got " + formatNumber(m.g));
+  if (std::fabs(m.g) == 1) {
+    // HG collapses to a delta there: sampling and evaluation would divide by zero.
+    m.g = std::copysign(0.9999f, m.g);
+    r.context().warn(key, "g = " + formatNumber(std::copysign(1.0f, m.g)) +
+                              " makes Henyey-Greenstein a delta function; clamped to " + formatNumber(m.g));
+  }
+  if (m.phase == PhaseFunction::Isotropic && m.g != 0)
+    r.context().warn(key, "ignored by the isotropic phase function (use \"phaseFunction\": \"hg\")");
+}
+
+Material readMaterial(JsonContext& ctx, const json& value, const std::string& key) {
+  ObjectReader r(ctx, value, key);
+  Material m;
+  m.name = r.requireString("name");
+  if (m.name.empty()) ctx.fail(r.keyOf("name"), "must not be empty");
+  m.type = requireEnum(r, "type", kMaterialTypes);
+  if (m.type == MaterialType::Emitter) {
+    m.albedo = r.requireVec3("albedo");
+    checkNonNegative(ctx, r.keyOf("albedo"), m.albedo);
+  } else {
+    m.scattering = r.requireVec3("scattering");
+    checkNonNegative(ctx, r.keyOf("scattering"), m.scattering);
+    m.absorption = r.requireVec3("absorption");
+    checkNonNegative(ctx, r.keyOf("absorption"), m.absorption);
+    m.phase = readEnum(r, "phaseFunction", kPhaseFunctions, m.phase);
+    readHenyeyGreensteinG(r, m);
+    if (const json* path = r.find("path"))
+      m.path = resolveVolumePath(toString(ctx, *path, r.keyOf("path")), ctx.file, r.keyOf("path"));
+    m.density = readNonNegative(r, "density", m.density);
+    m.gridName = r.getString("grid", m.gridName);
+    if (m.gridName.empty()) ctx.fail(r.keyOf("grid"), "must not be empty");
+    m.gridSpace = readEnum(r, "gridSpace", kGridSpaces, m.gridSpace);
+  }
+  r.reportUnknown();
+  return m;
+}
+
+Transform readTransform(JsonContext& ctx, const json& value, const std::string& key, PrimitiveType type) {
+  ObjectReader r(ctx, value, key);
+  Transform t;
+  t.position = r.getVec3("position", t.position);
+  t.scale = r.getVec3("scale", t.scale);
+  t.rotation = r.getVec3("rotation", t.rotation);
+  // A zero scale collapses the box (or the light's quad, which lies in local XY) to nothing.
+  const size_t checked = type == PrimitiveType::Volume ? 3 : type == PrimitiveType::Rectangle ? 2 : 0;
+  for (size_t i = 0; i < checked; ++i)
+    if (t.scale[i] == 0) ctx.fail(indexKey(r.keyOf("scale"), i), "must be non-zero, got 0");
+  r.reportUnknown();
+  return t;
+}
+
+Primitive readPrimitive(JsonContext& ctx, const json& value, const std::string& key) {
+  ObjectReader r(ctx, value, key);
+  Primitive p;
+  p.name = r.getString("name", p.name);
+  p.type = requireEnum(r, "type", kPrimitiveTypes);
+  if (const json* t = r.find("transform")) p.transform = readTransform(ctx, *t, r.keyOf("transform"), p.type);
+  p.materialName = r.requireString("materialName");
+  r.reportUnknown();
+  return p;
+}
+
+Vec3f sub(const Vec3f& a, const Vec3f& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+float length(const Vec3f& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
+Vec3f cross(const Vec3f& a, const Vec3f& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+Camera readCamera(JsonContext& ctx, const json& value, const std::string& key) {
+  ObjectReader r(ctx, value, key);
+  Camera c;
+  c.position = r.requireVec3("position");
+  c.lookAt = r.requireVec3("lookAt");
+  c.up = r.getVec3("up", c.up);
+  c.vfov = r.getFloat("vfov", c.vfov);
+  if (!(c.vfov > 0 && c.vfov < 180))
+    ctx.fail(r.keyOf("vfov"), "must be in (0, 180) degrees, got " + formatNumber(c.vfov));
+  c.aperture = readNonNegative(r, "aperture", c.aperture);
+  c.focus = r.getFloat("focus", c.focus);
+  if (!(c.focus > 0)) ctx.fail(r.keyOf("focus"), "must be positive, got " + formatNumber(c.focus));
+  c.speed = readNonNegative(r, "speed", c.speed);
+  // The camera basis is built from these: a degenerate one would render NaNs.
+  const Vec3f view = sub(c.lookAt, c.position);
+  if (length(view) == 0) ctx.fail(r.keyOf("lookAt"), "must differ from camera.position");
+  if (length(cross(view, c.up)) <= 1e-6f * length(view) * length(c.up))
+    ctx.fail(r.keyOf("up"), "must be non-zero and not parallel to the viewing direction");
+  r.reportUnknown();
+  return c;
+}
+
+ToneMapping readToneMapping(ObjectReader& r, ToneMapping fallback) {
+  const json* v = r.find("toneMapping");
+  if (!v) return fallback;
+  // Listing 4.1 writes a boolean; a name picks the operator.
+  if (v->is_boolean()) return v->get<bool>() ? ToneMapping::Aces : ToneMapping::None;
+  if (!v->is_string())
+    r.context().fail(r.keyOf("toneMapping"), "expected a boolean or one of " + allowedList(kToneMappings) +
+                                                 ", got " + v->type_name());
+  return toEnum(r.context(), *v, r.keyOf("toneMapping"), kToneMappings);
+}
+
+void readResolution(ObjectReader& r, RendererSettings& s) {
+  const std::string key = r.keyOf("resolution");
+  const json& v = r.require("resolution");
+  if (!v.is_array() || v.size() != 2)
+    r.context().fail(key, std::string("expected an array of 2 integers [width, height], got ") +
+                              (v.is_array() ? std::to_string(v.size()) + " elements" : v.type_name()));
+  int* sides[2] = {&s.width, &s.height};
+  for (size_t i = 0; i < 2; ++i)
+    *sides[i] = static_cast<int>(checkIntRange(r.context(), indexKey(key, i),
+                                               toInteger(r.context(), v[i], indexKey(key, i)), 1, kMaxImageSide));
+}
+
+RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::string& key) {
+  ObjectReader r(ctx, value, key);
+  RendererSettings s;
+  readResolution(r, s);
+  s.spp = readInt(r, "spp", s.spp, 1);
+  s.bounces = readInt(r, "bounces", s.bounces, 0);
+  s.hdr = r.getBool("HDR", s.hdr);
+  s.toneMapping = readToneMapping(r, s.toneMapping);
+  s.exposure = r.getFloat("exposure", s.exposure);
+  s.algorithm = readEnum(r, "algorithm", kAlgorithms, s.algorithm);
+  s.seed = static_cast<uint32_t>(checkIntRange(ctx, r.keyOf("seed"), r.getInteger("seed", s.seed), 0,
+                                               std::numeric_limits<uint32_t>::max()));
+  if (const json* v = r.find("raymarch")) {
+    ObjectReader m(ctx, *v, r.keyOf("raymarch"));
+    s.raymarch.steps = readInt(m, "steps", s.raymarch.steps, 1);
+    s.raymarch.shadowSteps = readInt(m, "shadowSteps", s.raymarch.shadowSteps, 1);
+    m.reportUnknown();
+  }
+  if (const json* v = r.find("lobe")) {
+    ObjectReader l(ctx, *v, r.keyOf("lobe"));
+    s.lobe.depthFactor = readNonNegative(l, "depthFactor", s.lobe.depthFactor);
+    s.lobe.lobePoints = readInt(l, "lobePoints", s.lobe.lobePoints, 1);
+    s.lobe.lobeRadius = readNonNegative(l, "lobeRadius", s.lobe.lobeRadius);
+    s.lobe.shadowSteps = readInt(l, "shadowSteps", s.lobe.shadowSteps, 1);
+    l.reportUnknown();
+  }
+  r.reportUnknown();
+  return s;
+}
+
+void readMaterials(JsonContext& ctx, ObjectReader& root, Scene& scene) {
+  const json& list = toArray(ctx, root.require("materials"), "materials");
+  std::map<std::string, size_t> byName;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const std::string key = indexKey("materials", i);
+    Material m = readMaterial(ctx, list[i], key);
+    const auto [it, inserted] = byName.emplace(m.name, i);
+    if (!inserted)
+      ctx.fail(key + ".name", "duplicate material name \"" + m.name + "\" (first used by " +
+                                  indexKey("materials", it->second) + ")");
+    scene.materials.push_back(std::move(m));
+  }
+}
+
+// Primitives name their material; the pairing decides what the renderer builds.
+void linkMaterial(const JsonContext& ctx, const Scene& scene, Primitive& p, const std::string& key) {
+  for (size_t i = 0; i < scene.materials.size(); ++i)
+    if (scene.materials[i].name == p.materialName) p.materialIndex = static_cast<int>(i);
+  if (p.materialIndex < 0) {
+    std::string names;
+    for (const Material& m : scene.materials) names += (names.empty() ? "\"" : ", \"") + m.name + "\"";
+    ctx.fail(key, "no material named \"" + p.materialName + "\" (defined: " +
+                      (names.empty() ? "none" : names) + ")");
+  }
+  const Material& m = scene.materials[p.materialIndex];
+  const MaterialType wanted = p.type == PrimitiveType::Volume ? MaterialType::Volume : MaterialType::Emitter;
+  if (m.type != wanted)
+    ctx.fail(key, std::string("a ") + primitiveTypeName(p.type) + " primitive needs " +
+                      (wanted == MaterialType::Volume ? "a volume" : "an emitter") + " material; \"" + m.name +
+                      "\" is " + (m.type == MaterialType::Volume ? "a " : "an ") + materialTypeName(m.type));
+}
+
+void readPrimitives(JsonContext& ctx, ObjectReader& root, Scene& scene) {
+  const json& list = toArray(ctx, root.require("primitives"), "primitives");
+  int volumes = 0;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const std::string key = indexKey("primitives", i);
+    Primitive p = readPrimitive(ctx, list[i], key);
+    linkMaterial(ctx, scene, p, key + ".materialName");
+    if (p.type == PrimitiveType::Volume && ++volumes > 1)
+      ctx.fail(key, "only one volume primitive is supported");
+    scene.primitives.push_back(std::move(p));
+  }
+}
+
+// Nothing emits: every pixel would be black, which users mistake for a renderer bug.
+void warnIfDark(const JsonContext& ctx, const Scene& scene) {
+  for (const Primitive& p : scene.primitives)
+    if (p.type != PrimitiveType::Volume) return;
+  if (scene.background != Vec3f{0, 0, 0}) return;
+  ctx.warn("", "no light and a black background: the image will be black");
+}
+
+std::string parseMessage(const json::exception& e) {
+  // Drop nlohmann's "[json.exception.parse_error.101] " tag; keep its line/column text.
+  const std::string what = e.what();
+  const size_t tag = what.find("] ");
+  return tag == std::string::npos ? what : what.substr(tag + 2);
+}
+
+}  // namespace
+
+Scene parseScene(const std::string& jsonText, const std::string& path, const std::vector<std::string>& overrides) {
+  Scene scene;
+  scene.sourcePath = path;
+  JsonContext ctx{path, &scene.warnings, {}};
+
+  json doc;
+  try {
+    doc = json::parse(jsonText);
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for 1e999
+    ctx.fail("", "invalid JSON: " + parseMessage(e));
+  }
+  if (!doc.is_object()) ctx.fail("", std::string("expected a JSON object at the top level, got ") + doc.type_name());
+
+  std::vector<std::pair<std::string, std::string>> overridden;  // (as written, loader key)
+  for (const std::string& spec : overrides)
+    overridden.emplace_back(spec.substr(0, spec.find('=')), applyOverride(doc, spec, path));
+
+  ObjectReader root(ctx, doc, "");
+  readMaterials(ctx, root, scene);
+  readPrimitives(ctx, root, scene);
+  scene.camera = readCamera(ctx, root.require("camera"), "camera");
+  scene.renderer = readRenderer(ctx, root.require("renderer"), "renderer");
+  scene.background = root.getVec3("background", scene.background);
+  checkNonNegative(ctx, "background", scene.background);
+  root.reportUnknown();
+
+  // In a file an unknown key is a warning; on the command line it is a typo the user is waiting on.
+  for (const auto& [written, key] : overridden)
+    for (const std::string& unknown : ctx.unknownKeys)
+      if (key == unknown || key.rfind(unknown + ".", 0) == 0 || key.rfind(unknown + "[", 0) == 0)
+        ctx.fail("--set " + written, "not a scene setting (unknown key " + unknown + ")");
+
+  warnIfDark(ctx, scene);
+  return scene;
+}
+
+Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  std::error_code ec;
+  if (!in || std::filesystem::is_directory(path, ec)) throw inputError(path, "", "cannot open scene file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseScene(text.str(), path, overrides);
+}
+
+const char* toneMappingName(ToneMapping t) {
+  switch (t) {
+    case ToneMapping::None: return "none";
+    case ToneMapping::Reinhard: return "reinhard";
+    case ToneMapping::Aces: return "aces";
+  }
+  return "none";
+}
+
+}  // namespace narval

@@ -1,0 +1,25 @@
+/* pathtrace.cl: thin entry point over shared/pathtrace.h. One work-item per pixel adds the samples
+ * [sample_begin, sample_begin + sample_count) to a compensated accumulator, so long renders run as
+ * many short launches (progress, no GPU watchdog) and any split gives the same per-sample values. */
+#include "shared/accum.h"
+#include "shared/pathtrace.h"
+
+__kernel void pathtrace(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
+                        __global float4* accum_sum, __global float4* accum_comp, uint sample_begin,
+                        uint sample_count, __global uint* status_word) {
+  const int x = get_global_id(0), y = get_global_id(1);
+  if (x >= scene->camera.width || y >= scene->camera.height) return;
+  uint status = 0u;
+  vec3 sum = vec3_splat(0.0f);
+  for (uint s = 0u; s < sample_count; ++s)
+    sum = vec3_add(sum, pathtrace_sample(scene, lights, GRID_ARG, x, y, sample_begin + s, &status));
+  const int idx = y * scene->camera.width + x;
+  const float4 a = accum_sum[idx], c = accum_comp[idx];
+  float ax = a.x, ay = a.y, az = a.z, cx = c.x, cy = c.y, cz = c.z;
+  accum_kahan_add(&ax, &cx, sum.x);
+  accum_kahan_add(&ay, &cy, sum.y);
+  accum_kahan_add(&az, &cz, sum.z);
+  accum_sum[idx] = (float4)(ax, ay, az, 0.0f);
+  accum_comp[idx] = (float4)(cx, cy, cz, 0.0f);
+  if (status) atomic_or(status_word, status);
+}

@@ -1,0 +1,35 @@
+/* camera.h: primary rays. Pixel (0,0) is the top-left corner; (jx, jy) in [0,1)² jitters the sample
+ * inside the pixel. A thin lens of radius lens_radius focuses at distance focus_distance along the
+ * view axis (pbrt-v4 §5.2.3); lens_radius 0 is a pinhole. */
+#ifndef NARVAL_CAMERA_H
+#define NARVAL_CAMERA_H
+
+#include "shared/sampling.h"
+#include "shared/structs.h"
+
+typedef struct ray3 {
+  vec3 origin;
+  vec3 dir; /* unit length */
+} ray3;
+
+static inline ray3 camera_ray(NV_CONSTANT const camera_params* c, float px, float py, float lens_u,
+                              float lens_v) {
+  const float sx = (2.0f * px / (float)c->width - 1.0f) * c->tan_half_vfov * c->aspect;
+  const float sy = (1.0f - 2.0f * py / (float)c->height) * c->tan_half_vfov;
+  const vec3 fwd = vec3_from4(c->forward), right = vec3_from4(c->right), up = vec3_from4(c->up);
+  vec3 dir = vec3_normalize(vec3_add(fwd, vec3_add(vec3_scale(right, sx), vec3_scale(up, sy))));
+  vec3 origin = vec3_from4(c->position);
+  if (c->lens_radius > 0.0f) {
+    float lx, ly;
+    sample_concentric_disk(lens_u, lens_v, &lx, &ly);
+    const vec3 focus = vec3_madd(origin, dir, c->focus_distance / vec3_dot(dir, fwd));
+    origin = vec3_add(origin, vec3_add(vec3_scale(right, c->lens_radius * lx), vec3_scale(up, c->lens_radius * ly)));
+    dir = vec3_normalize(vec3_sub(focus, origin));
+  }
+  ray3 r;
+  r.origin = origin;
+  r.dir = dir;
+  return r;
+}
+
+#endif

@@ -1,0 +1,106 @@
+/* pathtrace.h: one path-traced sample of a pixel (DESIGN.md "pathtrace"; dissertation §4.2-4.3).
+ * Free flight by delta/spectral tracking, next-event estimation at every real scattering event
+ * (ratio-tracked shadow rays, rectangle lights MIS-combined with phase sampling by the power
+ * heuristic, point lights by NEE alone), `max_bounces` real scattering events, escaped rays add the
+ * emitter they hit or the background. Rectangles are opaque: their back side is black. */
+#ifndef NARVAL_PATHTRACE_H
+#define NARVAL_PATHTRACE_H
+
+#include "shared/camera.h"
+#include "shared/light.h"
+#include "shared/medium.h"
+#include "shared/phase.h"
+#include "shared/tracking.h"
+
+/* Transmittance from x to the light point at distance `dist` along unit dir: 0 if another
+ * rectangle is in the way, else ratio tracking through the medium. */
+static inline vec3 pathtrace_shadow(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                    GRID_PARAM, int light_index, vec3 x, vec3 dir, float dist,
+                                    NV_PRIVATE rng_state* rng, NV_PRIVATE uint* status) {
+  float t_block;
+  int front;
+  if (intersect_lights(lights, s->num_lights, x, dir, 0.0f, light_index, &t_block, &front) >= 0 &&
+      t_block < dist)
+    return vec3_splat(0.0f);
+  medium_segment seg;
+  if (!s->has_medium || !medium_intersect(&s->medium, x, dir, 0.0f, dist, &seg)) return vec3_splat(1.0f);
+  return tracking_ratio(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, rng, status);
+}
+
+/* Direct light at a scattering point x for a path arriving along w_in, summed over all lights. */
+static inline vec3 pathtrace_direct(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                    GRID_PARAM, vec3 x, vec3 w_in, NV_PRIVATE rng_state* rng,
+                                    NV_PRIVATE uint* status) {
+  vec3 sum = vec3_splat(0.0f);
+  for (int i = 0; i < s->num_lights; ++i) {
+    const float u1 = rng_uniform(rng), u2 = rng_uniform(rng);
+    light_sample ls;
+    if (!light_sample_point(&lights[i], x, u1, u2, &ls)) continue;
+    const float f = phase_eval(s->medium.phase, s->medium.g, w_in, ls.dir);
+    if (!(f > 0.0f)) continue;
+    const vec3 tr = pathtrace_shadow(s, lights, GRID_ARG, i, x, ls.dir, ls.dist, rng, status);
+    if (vec3_is_zero(tr)) continue;
+    /* Point light: Le·f·Tr·I/d². Rectangle: Le·f·Tr/pdf_light weighted against phase sampling,
+     * whose pdf is f (sampling is exact). */
+    const float w = ls.pdf > 0.0f ? mis_power_heuristic(ls.pdf, f) / ls.pdf : 1.0f;
+    sum = vec3_add(sum, vec3_scale(vec3_mul(ls.radiance, tr), f * w));
+  }
+  return sum;
+}
+
+static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                    GRID_PARAM, int px, int py, uint sample, NV_PRIVATE uint* status) {
+  const uint pixel = (uint)py * (uint)s->camera.width + (uint)px;
+  rng_state rng = rng_init(s->seed, pixel, sample);
+  const float jx = rng_uniform(&rng), jy = rng_uniform(&rng);
+  const float lu = rng_uniform(&rng), lv = rng_uniform(&rng);
+  const ray3 cam = camera_ray(&s->camera, (float)px + jx, (float)py + jy, lu, lv);
+  vec3 o = cam.origin, d = cam.dir;
+  vec3 L = vec3_splat(0.0f), beta = vec3_splat(1.0f);
+  float prev_phase_pdf = 0.0f; /* 0: the ray left the camera, no MIS on what it hits */
+  int depth = 0;
+  for (;;) {
+    float t_surf;
+    int front = 0;
+    const int light_hit = intersect_lights(lights, s->num_lights, o, d, 0.0f, -1, &t_surf, &front);
+    medium_segment seg;
+    if (s->has_medium && medium_intersect(&s->medium, o, d, 0.0f, t_surf, &seg)) {
+      float t_hit;
+      const int event = tracking_delta(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit, status);
+      if (event == TRACK_ABSORBED) break;
+      if (event == TRACK_SCATTERED) {
+        if (++depth > s->max_bounces) break;
+        const vec3 x = vec3_madd(o, d, t_hit);
+        L = vec3_add(L, vec3_mul(beta, pathtrace_direct(s, lights, GRID_ARG, x, d, &rng, status)));
+        const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
+        float pdf;
+        d = phase_sample(s->medium.phase, s->medium.g, d, u1, u2, &pdf);
+        if (!(pdf > 0.0f)) {
+          *status |= STATUS_NEGATIVE_PDF;
+          break;
+        }
+        o = x;
+        prev_phase_pdf = pdf;
+        continue;
+      }
+    }
+    if (light_hit >= 0) {
+      if (front) {
+        float w = 1.0f;
+        if (prev_phase_pdf > 0.0f)
+          w = mis_power_heuristic(prev_phase_pdf, light_pdf_rectangle(&lights[light_hit], d, t_surf));
+        L = vec3_add(L, vec3_scale(vec3_mul(beta, vec3_from4(lights[light_hit].radiance)), w));
+      }
+    } else {
+      L = vec3_add(L, vec3_mul(beta, vec3_from4(s->background)));
+    }
+    break;
+  }
+  if (!vec3_is_finite(L)) {
+    *status |= STATUS_NAN;
+    return vec3_splat(0.0f);
+  }
+  return L;
+}
+
+#endif

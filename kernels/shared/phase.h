@@ -1,0 +1,53 @@
+/* phase.h: phase functions. θ is the angle between the propagation directions before (w_in) and
+ * after (w_out) scattering, so g > 0 scatters forward (DESIGN.md, physics conventions).
+ * Henyey-Greenstein: p(μ) = (1 − g²) / (4π (1 + g² − 2gμ)^{3/2}), normalised over the sphere. The
+ * dissertation's printed form (§2.6.2) drops the 3/2 exponent: a typo. Sampling inverts the CDF
+ * exactly, so pdf == eval and the sample weight eval/pdf is 1. */
+#ifndef NARVAL_PHASE_H
+#define NARVAL_PHASE_H
+
+#include "shared/sampling.h"
+
+/* Below this |g| HG is evaluated and sampled as isotropic: the inverse-CDF formula divides by g,
+ * and |p_HG − 1/(4π)| <= 3|g|/(4π)·(1+O(g)) is then under 1e-3 relative. */
+#define PHASE_HG_ISOTROPIC_EPS 1e-4f
+
+/* 1 + g² − 2gμ without cancellation near g → ±1, μ → ±1: (1−g)² + 2g(1−μ) for g ≥ 0 and
+ * (1+g)² − 2g(1+μ) for g < 0 (both expand to the same polynomial). */
+static inline float phase_hg_denominator(float g, float mu) {
+  return g >= 0.0f ? (1.0f - g) * (1.0f - g) + 2.0f * g * (1.0f - mu)
+                   : (1.0f + g) * (1.0f + g) - 2.0f * g * (1.0f + mu);
+}
+
+static inline float phase_hg_eval(float g, float mu) {
+  if (nv_fabs(g) < PHASE_HG_ISOTROPIC_EPS) return NV_INV_4PI;
+  const float d = phase_hg_denominator(g, mu);
+  return NV_INV_4PI * (1.0f - g) * (1.0f + g) / (d * nv_sqrt(d));
+}
+
+/* μ = cos θ drawn from HG by inverting its CDF (pbrt-v4 §11.3.1 form). */
+static inline float phase_hg_sample_cos(float g, float u) {
+  if (nv_fabs(g) < PHASE_HG_ISOTROPIC_EPS) return 1.0f - 2.0f * u;
+  const float s = (1.0f - g) * (1.0f + g) / (1.0f - g + 2.0f * g * u);
+  const float mu = (1.0f + g * g - s * s) / (2.0f * g);
+  return nv_fmin(1.0f, nv_fmax(-1.0f, mu));
+}
+
+/* Phase function selected by `kind` (PHASE_ISOTROPIC or PHASE_HG from structs.h). */
+static inline float phase_eval(int kind, float g, vec3 w_in, vec3 w_out) {
+  return kind == 1 ? phase_hg_eval(g, vec3_dot(w_in, w_out)) : NV_INV_4PI;
+}
+
+/* Samples w_out given the propagation direction w_in; returns it and writes its pdf. */
+static inline vec3 phase_sample(int kind, float g, vec3 w_in, float u1, float u2, NV_PRIVATE float* pdf) {
+  const float mu = kind == 1 ? phase_hg_sample_cos(g, u1) : 1.0f - 2.0f * u1;
+  const vec3 w_out = sample_direction_around(w_in, mu, u2);
+  *pdf = kind == 1 ? phase_hg_eval(g, mu) : NV_INV_4PI;
+  return w_out;
+}
+
+static inline float phase_pdf(int kind, float g, vec3 w_in, vec3 w_out) {
+  return phase_eval(kind, g, w_in, w_out);
+}
+
+#endif

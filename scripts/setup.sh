@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs missing Debian packages (as root; otherwise prints the apt-get line and stops), then
+# configures and builds Release into build/ (binary build/narval) and generates the default cloud.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(build-essential cmake pkg-config
+  pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
+  libopenvdb-dev libboost-iostreams-dev libtbb-dev libopenexr-dev libpng-dev
+  nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  if [ "$(id -u)" -eq 0 ]; then
+    echo "setup: installing ${missing[*]}"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  else
+    echo "setup: missing packages; run as root:" >&2
+    echo "  apt-get install -y ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$jobs"
+
+# The default scene's cloud is generated, not committed (deterministic for its seed).
+if [ ! -f scenes/data/cloud_128.vdb ]; then
+  mkdir -p scenes/data
+  build/narval make-cloud scenes/data/cloud_128.vdb --resolution 128 --seed 1
+fi

@@ -1,0 +1,420 @@
+// cl_runtime_test.cpp: device discovery and selection, the runtime, program builds (error logs
+// naming the real file and line) and the persistent program cache, on whatever OpenCL device the
+// machine has (PoCL in CI).
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cl/cl_runtime.h"
+#include "scene/input_error.h"
+
+namespace narval {
+const std::map<std::string, std::string>& testKernelSources();
+}
+
+namespace fs = std::filesystem;
+using namespace narval;
+
+namespace {
+
+#define SKIP_WITHOUT_DEVICES()                                                          \
+  do {                                                                                  \
+    if (listDevices().empty())                                                          \
+      GTEST_SKIP() << "no OpenCL platform or device on this machine (install pocl-opencl-icd)"; \
+  } while (0)
+
+// Sets (or unsets, with nullopt) an environment variable for one scope.
+class EnvGuard {
+ public:
+  EnvGuard(const char* name, const std::optional<std::string>& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    if (value)
+      setenv(name, value->c_str(), 1);
+    else
+      unsetenv(name);
+  }
+  ~EnvGuard() {
+    if (old_)
+      setenv(name_.c_str(), old_->c_str(), 1);
+    else
+      unsetenv(name_.c_str());
+  }
+
+ private:
+  std::string name_;
+  std::optional<std::string> old_;
+};
+
+// A fresh empty folder, removed at the end of the scope.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::path(testing::TempDir()) / "narval-cache-XXXXXX").string();
+    path_ = mkdtemp(&pattern[0]) ? fs::path(pattern) : fs::path();
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+  std::vector<fs::path> files() const {
+    std::vector<fs::path> out;
+    for (const auto& e : fs::directory_iterator(path_)) out.push_back(e.path());
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+ private:
+  fs::path path_;
+};
+
+// Runs cache_probe over n items and returns what it wrote.
+std::vector<cl_uint> runProbe(ClRuntime& rt, cl::Program& program, cl_uint n) {
+  cl::Buffer out(rt.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_uint));
+  cl::Kernel kernel(program, "cache_probe");
+  kernel.setArg(0, out);
+  kernel.setArg(1, n);
+  rt.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(n), cl::NullRange);
+  std::vector<cl_uint> result(n);
+  rt.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * sizeof(cl_uint), result.data());
+  return result;
+}
+
+void expectProbe(ClRuntime& rt, cl::Program& program, cl_uint factor) {
+  const std::vector<cl_uint> got = runProbe(rt, program, 1000);
+  for (cl_uint i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], i * factor) << "item " << i;
+}
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- discovery and selection
+
+TEST(Devices, ListsEveryDeviceWithItsProperties) {
+  SKIP_WITHOUT_DEVICES();
+  const std::vector<DeviceInfo> devices = listDevices();
+  for (size_t i = 0; i < devices.size(); ++i) {
+    const DeviceInfo& d = devices[i];
+    EXPECT_EQ(d.index, static_cast<int>(i));
+    EXPECT_FALSE(d.name.empty());
+    EXPECT_FALSE(d.platformName.empty());
+    EXPECT_TRUE(std::set<std::string>({"GPU", "CPU", "accelerator", "other"}).count(d.type)) << d.type;
+    EXPECT_GT(d.computeUnits, 0u);
+    EXPECT_GT(d.globalMemBytes, 0u);
+    EXPECT_GT(d.maxAllocBytes, 0u);
+    EXPECT_LE(d.maxAllocBytes, d.globalMemBytes);
+    EXPECT_GT(d.maxWorkGroupSize, 0u);
+    EXPECT_NE(d.deviceVersion.find("OpenCL"), std::string::npos) << d.deviceVersion;
+    if (d.imageSupport) EXPECT_GT(d.image3dMax[0] * d.image3dMax[1] * d.image3dMax[2], 0u);
+  }
+  EXPECT_EQ(listDevices().size(), devices.size()) << "the order must be stable";
+}
+
+TEST(Devices, DefaultPicksTheFirstGpuElseTheFirstCpu) {
+  SKIP_WITHOUT_DEVICES();
+  const std::vector<DeviceInfo> devices = listDevices();
+  int expected = -1;
+  for (const char* type : {"GPU", "CPU"}) {
+    for (const DeviceInfo& d : devices)
+      if (d.type == type) {
+        expected = d.index;
+        break;
+      }
+    if (expected >= 0) break;
+  }
+  if (expected < 0) expected = 0;
+  const SelectedDevice sel = selectDevice("");
+  EXPECT_EQ(sel.info.index, expected);
+  // (DeviceInfo trims the trailing spaces some drivers pad names with.)
+  EXPECT_EQ(std::string(sel.device.getInfo<CL_DEVICE_NAME>().c_str()).substr(0, sel.info.name.size()),
+            sel.info.name);
+}
+
+TEST(Devices, SelectsByIndex) {
+  SKIP_WITHOUT_DEVICES();
+  const std::vector<DeviceInfo> devices = listDevices();
+  for (const DeviceInfo& d : devices) {
+    const SelectedDevice sel = selectDevice(std::to_string(d.index));
+    EXPECT_EQ(sel.info.index, d.index);
+    EXPECT_EQ(sel.info.name, d.name);
+    EXPECT_EQ(sel.platform.getInfo<CL_PLATFORM_NAME>().c_str(), d.platformName);
+  }
+}
+
+TEST(Devices, SelectsByCaseInsensitiveSubstringOfTheName) {
+  SKIP_WITHOUT_DEVICES();
+  const std::vector<DeviceInfo> devices = listDevices();
+  // PoCL's CPU device is called "pthread-<cpu>-<model>" (clinfo -l); the platform, not the device,
+  // is "Portable Computing Language".
+  for (const DeviceInfo& d : devices)
+    if (d.name.find("pthread") != std::string::npos) {
+      EXPECT_EQ(selectDevice("PTHREAD").info.name.find("pthread"), 0u);
+      break;
+    }
+  // Any device: its own name in upper case finds it (or an earlier device with the same name).
+  const DeviceInfo& last = devices.back();
+  std::string upper = last.name;
+  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  EXPECT_EQ(selectDevice(upper).info.name, last.name);
+}
+
+TEST(Devices, NoMatchIsAnInputErrorListingTheDevices) {
+  SKIP_WITHOUT_DEVICES();
+  std::string list;
+  for (const DeviceInfo& d : listDevices())
+    list += (list.empty() ? "" : ", ") + std::to_string(d.index) + ": " + d.name;
+  try {
+    selectDevice("xyz-no-such-device");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "--device: no OpenCL device matches 'xyz-no-such-device' (devices: " + list + ")");
+  }
+  EXPECT_THROW(selectDevice(std::to_string(listDevices().size())), InputError);
+  EXPECT_THROW(selectDevice("99999999999999999999"), InputError);
+}
+
+// A machine without any OpenCL platform: this binary runs again with an ICD folder that does not
+// exist (ocl-icd and the Khronos loader read OCL_ICD_VENDORS once, at the first OpenCL call).
+TEST(Devices, NoPlatformGivesAnEmptyListAndAClearError) {
+  if (std::getenv("NARVAL_TEST_NO_PLATFORM_CHILD")) {
+    if (!listDevices().empty()) GTEST_SKIP() << "the ICD loader ignored OCL_ICD_VENDORS";
+    try {
+      selectDevice("");
+      FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "no OpenCL platform found: install an OpenCL driver (e.g. Debian's pocl-opencl-icd)");
+    }
+    EXPECT_THROW(ClRuntime("0"), InputError);
+    EXPECT_EQ(devicesJson({}), "[]\n");
+    return;
+  }
+  const fs::path self = fs::read_symlink("/proc/self/exe");
+  TempDir dir;
+  const fs::path log = dir.path() / "child.log";
+  const std::string cmd = "NARVAL_TEST_NO_PLATFORM_CHILD=1 OCL_ICD_VENDORS='" + (dir.path() / "none").string() +
+                          "' '" + self.string() +
+                          "' --gtest_filter=Devices.NoPlatformGivesAnEmptyListAndAClearError > '" +
+                          log.string() + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  const std::string out = readFile(log);
+  if (out.find("[  SKIPPED ] 1 test") != std::string::npos) GTEST_SKIP() << out;
+  EXPECT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("[  PASSED  ] 1 test"), std::string::npos) << out;
+}
+
+TEST(Devices, JsonParsesWithEveryKey) {
+  SKIP_WITHOUT_DEVICES();
+  const std::vector<DeviceInfo> devices = listDevices();
+  const nlohmann::json j = nlohmann::json::parse(devicesJson(devices));
+  ASSERT_TRUE(j.is_array());
+  ASSERT_EQ(j.size(), devices.size());
+  for (const char* key : {"index", "platform", "name", "vendor", "type", "driver_version",
+                          "device_version", "opencl_c_version", "compute_units", "global_mem_bytes",
+                          "max_alloc_bytes", "local_mem_bytes", "max_work_group_size", "image_support",
+                          "image3d_max", "fp64"})
+    EXPECT_TRUE(j[0].contains(key)) << key;
+  EXPECT_EQ(j[0]["name"], devices[0].name);
+  EXPECT_EQ(j[0]["global_mem_bytes"].get<size_t>(), devices[0].globalMemBytes);
+  ASSERT_TRUE(j[0]["image3d_max"].is_array());
+  EXPECT_EQ(j[0]["image3d_max"].size(), 3u);
+  EXPECT_TRUE(j[0]["fp64"].is_boolean());
+  EXPECT_EQ(nlohmann::json::parse(devicesJson({})), nlohmann::json::array());
+}
+
+TEST(Devices, TextHasAHeaderAndOneRowPerDevice) {
+  SKIP_WITHOUT_DEVICES();
+  const std::vector<DeviceInfo> devices = listDevices();
+  const std::string text = devicesText(devices);
+  size_t lines = 0;
+  for (char c : text) lines += c == '\n';
+  EXPECT_EQ(lines, devices.size() + 1) << text;
+  for (const DeviceInfo& d : devices) EXPECT_NE(text.find(d.name), std::string::npos) << text;
+  EXPECT_NE(text.find("global mem"), std::string::npos) << text;
+  EXPECT_NE(devicesText({}).find("no OpenCL device"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- runtime and errors
+
+TEST(ClRuntime, OpensAContextAndAProfilingQueue) {
+  SKIP_WITHOUT_DEVICES();
+  ClRuntime rt("");
+  EXPECT_EQ(rt.context.getInfo<CL_CONTEXT_DEVICES>().size(), 1u);
+  EXPECT_TRUE(rt.queue.getInfo<CL_QUEUE_PROPERTIES>() & CL_QUEUE_PROFILING_ENABLE);
+  EXPECT_THROW(ClRuntime("xyz-no-such-device"), InputError);
+}
+
+TEST(ClRuntime, NamesErrorCodes) {
+  EXPECT_EQ(clErrorName(CL_OUT_OF_RESOURCES), "CL_OUT_OF_RESOURCES (-5)");
+  EXPECT_EQ(clErrorName(0), "CL_SUCCESS (0)");
+  EXPECT_EQ(clErrorName(-11), "CL_BUILD_PROGRAM_FAILURE (-11)");
+  EXPECT_EQ(clErrorName(-68), "CL_INVALID_DEVICE_PARTITION_COUNT (-68)");
+  EXPECT_EQ(clErrorName(-1001), "CL_PLATFORM_NOT_FOUND_KHR (-1001)");
+  EXPECT_EQ(clErrorName(-12345), "unknown OpenCL error (-12345)");
+  // Every OpenCL 1.2 code has a name.
+  for (int code = -68; code <= 0; ++code)
+    if (code >= -19 || code <= -30)
+      EXPECT_EQ(clErrorName(code).rfind("CL_", 0), 0u) << clErrorName(code);
+  EXPECT_EQ(clErrorText(cl::Error(-5, "clEnqueueNDRangeKernel")),
+            "clEnqueueNDRangeKernel: CL_OUT_OF_RESOURCES (-5)");
+}
+
+// ---------------------------------------------------------------- program builds and cache
+
+TEST(ProgramCache, BuildErrorNamesTheRealFileAndLine) {
+  SKIP_WITHOUT_DEVICES();
+  EnvGuard cache("NARVAL_CACHE_DIR", std::string("off"));
+  // The line of the deliberate error, read from the file itself so the test follows edits.
+  std::ifstream in(std::string(NARVAL_SOURCE_DIR) + "/tests/device/build_error_test.cl");
+  ASSERT_TRUE(in) << "cannot read build_error_test.cl";
+  int errorLine = 0;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n)
+    if (line.find("deliberate type error") != std::string::npos) errorLine = n;
+  ASSERT_GT(errorLine, 0);
+
+  ClRuntime rt("");
+  try {
+    buildProgram(rt, "build_error_test.cl", "", &testKernelSources());
+    FAIL() << "expected ProgramBuildError";
+  } catch (const ProgramBuildError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("OpenCL build of build_error_test.cl failed:\n", 0), 0u) << what;
+    EXPECT_NE(what.find("tests/device/build_error_test.cl:" + std::to_string(errorLine) + ":"),
+              std::string::npos)
+        << "the log must name the real file and line " << errorLine << ":\n"
+        << what;
+  }
+}
+
+TEST(ProgramCache, UnknownKernelFileIsARuntimeError) {
+  SKIP_WITHOUT_DEVICES();
+  ClRuntime rt("");
+  EXPECT_THROW(buildProgram(rt, "no_such_kernel.cl", "", &testKernelSources()), std::runtime_error);
+}
+
+TEST(ProgramCache, SecondBuildComesFromTheCacheAndRuns) {
+  SKIP_WITHOUT_DEVICES();
+  TempDir dir;
+  ASSERT_FALSE(dir.path().empty());
+  EnvGuard cache("NARVAL_CACHE_DIR", dir.path().string());
+  ClRuntime rt("");
+  bool hit = true;
+  cl::Program first = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+  EXPECT_FALSE(hit);
+  ASSERT_EQ(dir.files().size(), 1u);
+  EXPECT_EQ(dir.files()[0].extension(), ".bin");
+  expectProbe(rt, first, 2);
+
+  cl::Program second = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+  EXPECT_TRUE(hit);
+  EXPECT_EQ(dir.files().size(), 1u);
+  expectProbe(rt, second, 2);
+
+  // A fresh runtime (as a second narval process would have) also hits.
+  ClRuntime other("");
+  cl::Program third = buildProgram(other, "cache_probe.cl", "", &testKernelSources(), &hit);
+  EXPECT_TRUE(hit);
+  expectProbe(other, third, 2);
+}
+
+TEST(ProgramCache, OptionsChangeTheKey) {
+  SKIP_WITHOUT_DEVICES();
+  TempDir dir;
+  EnvGuard cache("NARVAL_CACHE_DIR", dir.path().string());
+  ClRuntime rt("");
+  bool hit = true;
+  buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+  EXPECT_FALSE(hit);
+  cl::Program three = buildProgram(rt, "cache_probe.cl", "-DPROBE_FACTOR=3", &testKernelSources(), &hit);
+  EXPECT_FALSE(hit);
+  EXPECT_EQ(dir.files().size(), 2u);
+  expectProbe(rt, three, 3);
+  cl::Program cached = buildProgram(rt, "cache_probe.cl", "-DPROBE_FACTOR=3", &testKernelSources(), &hit);
+  EXPECT_TRUE(hit);
+  expectProbe(rt, cached, 3);
+}
+
+TEST(ProgramCache, CorruptEntriesFallBackToTheSourceAndAreRewritten) {
+  SKIP_WITHOUT_DEVICES();
+  TempDir dir;
+  EnvGuard cache("NARVAL_CACHE_DIR", dir.path().string());
+  ClRuntime rt("");
+  bool hit = true;
+  buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+  ASSERT_EQ(dir.files().size(), 1u);
+  const fs::path entry = dir.files()[0];
+  const std::string good = readFile(entry);
+
+  // Truncated: the header's size no longer matches.
+  std::ofstream(entry, std::ios::binary | std::ios::trunc) << good.substr(0, good.size() / 2);
+  cl::Program a = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+  EXPECT_FALSE(hit);
+  expectProbe(rt, a, 2);
+  EXPECT_EQ(readFile(entry), good) << "the entry is rewritten";
+
+  // A well-formed entry whose payload the driver must refuse.
+  const std::string payload = "this is not a program binary";
+  std::string forged = "NARVALCL";
+  for (std::uint64_t v : {std::uint64_t(payload.size()), fnv1a64(payload)})
+    for (int i = 0; i < 8; ++i) forged.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+  std::ofstream(entry, std::ios::binary | std::ios::trunc) << forged + payload;
+  cl::Program b = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+  EXPECT_FALSE(hit);
+  expectProbe(rt, b, 2);
+  buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+  EXPECT_TRUE(hit);
+}
+
+TEST(ProgramCache, OffAndUnwritableFoldersNeverFail) {
+  SKIP_WITHOUT_DEVICES();
+  ClRuntime rt("");
+  bool hit = true;
+  {
+    EnvGuard cache("NARVAL_CACHE_DIR", std::string("off"));
+    EXPECT_EQ(programCacheDir(), "");
+    cl::Program p = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+    EXPECT_FALSE(hit);
+    expectProbe(rt, p, 2);
+  }
+  {
+    // A folder under a regular file can never be created.
+    TempDir dir;
+    const fs::path file = dir.path() / "a-file";
+    std::ofstream(file) << "x";
+    EnvGuard cache("NARVAL_CACHE_DIR", (file / "cache").string());
+    cl::Program p = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
+    EXPECT_FALSE(hit);
+    expectProbe(rt, p, 2);
+  }
+}
+
+TEST(ProgramCache, FolderFollowsTheEnvironment) {
+  EnvGuard narval("NARVAL_CACHE_DIR", std::nullopt);
+  {
+    EnvGuard xdg("XDG_CACHE_HOME", std::string("/tmp/xdg"));
+    EXPECT_EQ(programCacheDir(), "/tmp/xdg/narval");
+  }
+  {
+    EnvGuard xdg("XDG_CACHE_HOME", std::nullopt);
+    EnvGuard home("HOME", std::string("/home/someone"));
+    EXPECT_EQ(programCacheDir(), "/home/someone/.cache/narval");
+  }
+  EnvGuard set("NARVAL_CACHE_DIR", std::string("/var/tmp/nc"));
+  EXPECT_EQ(programCacheDir(), "/var/tmp/nc");
+}

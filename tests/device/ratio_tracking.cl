@@ -1,0 +1,30 @@
+/* Test kernel: ratio-tracking transmittance along world-space rays through the medium, n samples
+ * per ray, returning the mean and the sample variance of the red channel. */
+#include "shared/medium.h"
+#include "shared/tracking.h"
+
+__kernel void ratio_tracking_stats(__constant medium_params* m, GRID_KERNEL_PARAM, __global const float4* rays,
+                                   uint n, __global float* out_mean, __global float* out_var,
+                                   __global uint* status_word) {
+  const int i = get_global_id(0);
+  const vec3 o = rays[2 * i].xyz;
+  const vec3 d = rays[2 * i + 1].xyz;
+  uint status = 0u;
+  medium_segment seg;
+  float mean = 0.0f, m2 = 0.0f;
+  if (medium_intersect(m, o, d, 0.0f, NV_INFINITY, &seg)) {
+    for (uint s = 0u; s < n; ++s) {
+      rng_state rng = rng_init(1234u, (uint)i, s);
+      const float tr = tracking_ratio(m, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &status).x;
+      /* Welford's running mean and variance */
+      const float delta = tr - mean;
+      mean += delta / (float)(s + 1u);
+      m2 += delta * (tr - mean);
+    }
+  } else {
+    mean = 1.0f;
+  }
+  out_mean[i] = mean;
+  out_var[i] = n > 1u ? m2 / (float)(n - 1u) : 0.0f;
+  if (status) atomic_or(status_word, status);
+}

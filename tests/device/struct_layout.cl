@@ -1,0 +1,51 @@
+/* struct_layout.cl: the size and field offsets of every struct that crosses host and device
+ * (kernels/shared/structs.h, and the vec3.h storage types they are built from), as the OpenCL
+ * compiler lays them out. tests/device/struct_layout_test.cpp includes this very file as C++ to get
+ * the same list, so the host and device lists cannot drift apart; only the kernel is OpenCL-only.
+ * Output: out[0] = number of entries, then per entry one value: sizeof(type) for STRUCT_LAYOUT_SIZE,
+ * offsetof and sizeof of the field for STRUCT_LAYOUT_FIELD (two values). */
+#include "shared/structs.h"
+
+/* offsetof is not part of OpenCL C 1.2; clang (and GCC, on the host) provide the builtin. */
+#define STRUCT_LAYOUT_OFFSETOF(type, field) __builtin_offsetof(type, field)
+#define STRUCT_LAYOUT_FIELD_SIZE(type, field) sizeof(((type*)0)->field)
+
+/* S(type): the struct's size. F(type, field): one field (nested designators allowed). */
+#define STRUCT_LAYOUT_ENTRIES(S, F)                                                                \
+  S(nv_float4) F(nv_float4, x) F(nv_float4, y) F(nv_float4, z) F(nv_float4, w)                     \
+  S(nv_affine) F(nv_affine, row[0]) F(nv_affine, row[1]) F(nv_affine, row[2])                     \
+  S(camera_params) F(camera_params, position) F(camera_params, forward) F(camera_params, right)     \
+  F(camera_params, up) F(camera_params, tan_half_vfov) F(camera_params, aspect)                    \
+  F(camera_params, lens_radius) F(camera_params, focus_distance) F(camera_params, width)           \
+  F(camera_params, height) F(camera_params, pad0) F(camera_params, pad1)                           \
+  S(light_params) F(light_params, corner) F(light_params, edge_u) F(light_params, edge_v)          \
+  F(light_params, normal) F(light_params, radiance) F(light_params, type) F(light_params, pad0)    \
+  F(light_params, pad1) F(light_params, pad2)                                                      \
+  S(medium_params) F(medium_params, world_to_index) F(medium_params, world_to_index.row[2])        \
+  F(medium_params, dims) F(medium_params, sigma_a) F(medium_params, sigma_s)                       \
+  F(medium_params, majorant) F(medium_params, g) F(medium_params, phase) F(medium_params, grey)    \
+  S(scene_params) F(scene_params, camera) F(scene_params, camera.height) F(scene_params, medium)    \
+  F(scene_params, medium.sigma_s) F(scene_params, medium.grey) F(scene_params, background)         \
+  F(scene_params, has_medium) F(scene_params, num_lights) F(scene_params, max_bounces)             \
+  F(scene_params, seed)
+
+#ifdef __OPENCL_C_VERSION__
+
+#define STRUCT_LAYOUT_PUT(v) \
+  do {                       \
+    if (n < capacity) out[n] = (uint)(v); \
+    ++n;                     \
+  } while (0);
+#define STRUCT_LAYOUT_DEVICE_SIZE(type) STRUCT_LAYOUT_PUT(sizeof(type))
+#define STRUCT_LAYOUT_DEVICE_FIELD(type, field)            \
+  STRUCT_LAYOUT_PUT(STRUCT_LAYOUT_OFFSETOF(type, field)) \
+  STRUCT_LAYOUT_PUT(STRUCT_LAYOUT_FIELD_SIZE(type, field))
+
+__kernel void struct_layout(__global uint* out, uint capacity) {
+  if (get_global_id(0) != 0) return;
+  uint n = 1u;
+  STRUCT_LAYOUT_ENTRIES(STRUCT_LAYOUT_DEVICE_SIZE, STRUCT_LAYOUT_DEVICE_FIELD)
+  out[0] = n - 1u;
+}
+
+#endif
