@@ -10,15 +10,16 @@ __kernel void pathtrace(__constant scene_params* scene, __constant light_params*
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
   uint status = 0u;
-  vec3 sum = vec3_splat(0.0f);
-  for (uint s = 0u; s < sample_count; ++s)
-    sum = vec3_add(sum, pathtrace_sample(scene, lights, GRID_ARG, x, y, sample_begin + s, &status));
   const int idx = y * scene->camera.width + x;
   const float4 a = accum_sum[idx], c = accum_comp[idx];
   float ax = a.x, ay = a.y, az = a.z, cx = c.x, cy = c.y, cz = c.z;
-  accum_kahan_add(&ax, &cx, sum.x);
-  accum_kahan_add(&ay, &cy, sum.y);
-  accum_kahan_add(&az, &cz, sum.z);
+  /* Every sample goes through the compensated sum: a small image may run 10⁶ samples in one launch. */
+  for (uint s = 0u; s < sample_count; ++s) {
+    const vec3 L = pathtrace_sample(scene, lights, GRID_ARG, x, y, sample_begin + s, &status);
+    accum_kahan_add(&ax, &cx, L.x);
+    accum_kahan_add(&ay, &cy, L.y);
+    accum_kahan_add(&az, &cz, L.z);
+  }
   accum_sum[idx] = (float4)(ax, ay, az, 0.0f);
   accum_comp[idx] = (float4)(cx, cy, cz, 0.0f);
   if (status) atomic_or(status_word, status);

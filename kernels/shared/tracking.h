@@ -14,6 +14,7 @@
 
 #include "shared/grid.h"
 #include "shared/rng.h"
+#include "shared/sampling.h"
 #include "shared/structs.h"
 
 /* A guard against endless walks (σ̄·length of ~10⁷ mean free paths); flagged in the status word. */

@@ -42,8 +42,13 @@ std::vector<LayoutValue> hostLayout() {
 // camera 4·16 + 8·4 = 96, light 5·16 + 4·4 = 96, medium 48 + 3·16 + 4·4 = 112,
 // scene 96 + 112 + 16 + 4·4 = 240. A change to a struct must be a deliberate change here too.
 TEST(StructLayoutHost, SizesAreMultiplesOf16) {
-  for (const LayoutValue& v : hostLayout())
-    if (v.isStructSize) EXPECT_EQ(v.value % 16u, 0u) << v.what << " = " << v.value;
+  int structs = 0;
+  for (const LayoutValue& v : hostLayout()) {
+    if (!v.isStructSize) continue;
+    ++structs;
+    EXPECT_EQ(v.value % 16u, 0u) << v.what << " = " << v.value;
+  }
+  EXPECT_EQ(structs, 6);  // nv_float4, nv_affine, camera, light, medium, scene
   EXPECT_EQ(sizeof(nv_float4), 16u);
   EXPECT_EQ(sizeof(nv_affine), 48u);
   EXPECT_EQ(sizeof(camera_params), 96u);
