@@ -159,12 +159,16 @@ SelectedDevice selectDevice(const std::string& spec) {
                        "no OpenCL device has index " + spec + " (devices: " + deviceListForMessage(found) + ")");
     chosen = &found[index];
   } else {
+    // The device name first (DESIGN.md); then the platform name, so "pocl" or "nvidia" work too.
     const std::string needle = lower(spec);
-    for (const Found& f : found)
-      if (lower(f.info.name).find(needle) != std::string::npos) {
-        chosen = &f;
-        break;
-      }
+    for (const bool byPlatform : {false, true}) {
+      for (const Found& f : found)
+        if (lower(byPlatform ? f.info.platformName : f.info.name).find(needle) != std::string::npos) {
+          chosen = &f;
+          break;
+        }
+      if (chosen) break;
+    }
     if (!chosen)
       throw inputError("--device", "",
                        "no OpenCL device matches '" + spec + "' (devices: " + deviceListForMessage(found) + ")");

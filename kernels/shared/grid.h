@@ -46,7 +46,10 @@ static inline float grid_voxel(const grid_view* g, int x, int y, int z) {
 
 static inline float grid_density(GRID_PARAM, vec3 p) {
   if (!grid->data) return 1.0f;
-  const float fx = p.x - 0.5f, fy = p.y - 0.5f, fz = p.z - 0.5f;
+  /* The device's clamp, so huge or infinite coordinates read 0 here too (and never overflow int). */
+  const float fx = fminf(fmaxf(p.x, -1.0f), 1.0e7f) - 0.5f;
+  const float fy = fminf(fmaxf(p.y, -1.0f), 1.0e7f) - 0.5f;
+  const float fz = fminf(fmaxf(p.z, -1.0f), 1.0e7f) - 0.5f;
   const float x0f = floorf(fx), y0f = floorf(fy), z0f = floorf(fz);
   const int x0 = (int)x0f, y0 = (int)y0f, z0 = (int)z0f;
   const float ax = fx - x0f, ay = fy - y0f, az = fz - z0f;

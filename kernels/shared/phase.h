@@ -42,7 +42,9 @@ static inline float phase_eval(int kind, float g, vec3 w_in, vec3 w_out) {
 static inline vec3 phase_sample(int kind, float g, vec3 w_in, float u1, float u2, NV_PRIVATE float* pdf) {
   const float mu = kind == 1 ? phase_hg_sample_cos(g, u1) : 1.0f - 2.0f * u1;
   const vec3 w_out = sample_direction_around(w_in, mu, u2);
-  *pdf = kind == 1 ? phase_hg_eval(g, mu) : NV_INV_4PI;
+  /* The pdf of the direction actually returned: for |g| near 1 the HG peak is a few float steps
+   * of μ wide, and MIS needs the same value phase_pdf gives for this direction. */
+  *pdf = kind == 1 ? phase_hg_eval(g, vec3_dot(w_in, w_out)) : NV_INV_4PI;
   return w_out;
 }
 

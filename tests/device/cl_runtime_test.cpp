@@ -172,6 +172,18 @@ TEST(Devices, SelectsByCaseInsensitiveSubstringOfTheName) {
   EXPECT_EQ(selectDevice(upper).info.name, last.name);
 }
 
+TEST(Devices, FallsBackToThePlatformName) {
+  SKIP_WITHOUT_DEVICES();
+  // No device name contains "computing language"; PoCL's platform name does, so the first device
+  // of that platform is chosen. On a machine without PoCL the spec matches nothing.
+  for (const DeviceInfo& d : listDevices())
+    if (d.platformName == "Portable Computing Language") {
+      EXPECT_EQ(selectDevice("computing LANGUAGE").info.platformName, "Portable Computing Language");
+      return;
+    }
+  GTEST_SKIP() << "PoCL is not installed here";
+}
+
 TEST(Devices, NoMatchIsAnInputErrorListingTheDevices) {
   SKIP_WITHOUT_DEVICES();
   std::string list;

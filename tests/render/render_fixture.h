@@ -10,6 +10,7 @@
 #include "cl/cl_runtime.h"
 #include "render/pathtrace_renderer.h"
 #include "scene/scene.h"
+#include "unit/stat_util.h"
 
 namespace narval::test {
 
@@ -28,21 +29,17 @@ inline RenderResult render(const Scene& scene, const DenseGrid* grid = nullptr, 
   return renderPathtrace(runtime(), scene, grid, o);
 }
 
-// Mean and standard error of the image mean for channel c.
+// Mean and standard error of the image mean for channel c (pixels as independent samples).
 struct ChannelStats {
   double mean = 0, stderrOfMean = 0;
 };
 inline ChannelStats channelStats(const ImageRGB& img, int c) {
-  const size_t n = size_t(img.width) * img.height;
-  double s = 0, s2 = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const double v = img.rgb[i * 3 + c];
-    s += v;
-    s2 += v * v;
-  }
+  MeanAccumulator acc;
+  for (size_t i = 0, n = size_t(img.width) * img.height; i < n; ++i) acc.add(img.rgb[i * 3 + c]);
+  const MeanSe r = acc.result();
   ChannelStats st;
-  st.mean = s / n;
-  st.stderrOfMean = std::sqrt(std::max(0.0, s2 / n - st.mean * st.mean) / (n - 1));
+  st.mean = r.mean;
+  st.stderrOfMean = r.se;
   return st;
 }
 

@@ -18,93 +18,16 @@
 
 #include "shared/phase.h"
 #include "shared/structs.h"
+#include "unit/stat_util.h"
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// ---- statistics helpers (double precision) ----
+// χ² helpers (gammaQ, chiSquarePValue, sidak, chiSquare with pooling): tests/unit/stat_util.h.
+using namespace narval::test;
 
-// Regularized lower incomplete gamma P(a, x) (Numerical Recipes §6.2: series for x < a + 1, Lentz's
-// continued fraction otherwise); the χ² upper-tail p-value with k degrees of freedom is
-// Q(k/2, χ²/2) = 1 − P(k/2, χ²/2).
-double gammaQ(double a, double x) {
-  if (x <= 0.0) return 1.0;
-  const double lnPre = -x + a * std::log(x) - std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, sum = 1.0 / a, del = sum;
-    for (int n = 0; n < 100000; ++n) {
-      ap += 1.0;
-      del *= x / ap;
-      sum += del;
-      if (std::fabs(del) < std::fabs(sum) * 1e-15) break;
-    }
-    return 1.0 - sum * std::exp(lnPre);
-  }
-  const double tiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::fabs(d) < tiny) d = tiny;
-    c = b + an / c;
-    if (std::fabs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::fabs(del - 1.0) < 1e-15) break;
-  }
-  return std::exp(lnPre) * h;
-}
-
-double chiSquarePValue(double chi2, int dof) { return gammaQ(0.5 * dof, 0.5 * chi2); }
-
-// Šidák: per-test significance so that `tests` independent tests reject a true null with total
-// probability `alpha`.
-double sidak(double alpha, int tests) { return 1.0 - std::pow(1.0 - alpha, 1.0 / tests); }
-
-struct ChiSquareResult {
-  double chi2 = 0.0;
-  int dof = 0;
-  double pValue = 1.0;
-  int64_t samplesInZeroCells = 0;
-};
-
-// Pearson's χ² with Mitsuba's pooling: cells are visited by increasing expected count; cells with
-// an expected count below `minExpected` are pooled until the pool reaches it. Cells with zero
-// expected count must stay (almost) empty.
-ChiSquareResult chiSquare(const std::vector<double>& observed, const std::vector<double>& expected,
-                          double minExpected = 5.0) {
-  std::vector<size_t> order(observed.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return expected[a] < expected[b]; });
-  ChiSquareResult r;
-  double pooledObs = 0.0, pooledExp = 0.0;
-  for (size_t i : order) {
-    if (expected[i] == 0.0) {
-      r.samplesInZeroCells += static_cast<int64_t>(observed[i]);
-    } else if (expected[i] < minExpected || (pooledExp > 0.0 && pooledExp < minExpected)) {
-      pooledObs += observed[i];
-      pooledExp += expected[i];
-      if (pooledExp >= minExpected) {
-        r.chi2 += (pooledObs - pooledExp) * (pooledObs - pooledExp) / pooledExp;
-        ++r.dof;
-        pooledObs = pooledExp = 0.0;
-      }
-    } else {
-      r.chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-      ++r.dof;
-    }
-  }
-  if (pooledExp > 0.0) {
-    r.chi2 += (pooledObs - pooledExp) * (pooledObs - pooledExp) / pooledExp;
-    ++r.dof;
-  }
-  r.dof -= 1;  // the counts are constrained to sum to N
-  r.pValue = chiSquarePValue(r.chi2, r.dof);
-  return r;
-}
+// ---- helpers (double precision) ----
 
 // Adaptive Simpson on [a, b] to absolute tolerance `tol`.
 double adaptiveSimpsonRec(const std::function<double(double)>& f, double a, double b, double fa, double fm,
@@ -209,6 +132,22 @@ TEST(PhaseStatHelpers, ChiSquareTailMatchesTables) {
   // Q(a, 0) = 1 and Q(k/2, x) decreases in x.
   EXPECT_DOUBLE_EQ(chiSquarePValue(0.0, 7), 1.0);
   EXPECT_GT(chiSquarePValue(5.0, 7), chiSquarePValue(6.0, 7));
+}
+
+// Pooling: expected counts {1, 2, 3, 10, 10, 10} pool the three small cells (1 + 2 = 3 < 5, + 3 = 6)
+// into one, leaving 4 cells and dof = 3. Observed {3, 0, 3, 10, 10, 10} matches the pooled
+// expectation exactly (χ² = 0); {0, 0, 0, 10, 10, 16} gives (0 − 6)²/6 + (16 − 10)²/10 = 9.6.
+// A sample in a zero-probability cell is counted, never pooled away.
+TEST(PhaseStatHelpers, PoolsSmallCells) {
+  const std::vector<double> expected = {1, 2, 3, 10, 10, 10};
+  ChiSquareResult r = chiSquare({3, 0, 3, 10, 10, 10}, expected);
+  EXPECT_EQ(r.dof, 3);
+  EXPECT_DOUBLE_EQ(r.chi2, 0.0);
+  r = chiSquare({0, 0, 0, 10, 10, 16}, expected);
+  EXPECT_EQ(r.dof, 3);
+  EXPECT_DOUBLE_EQ(r.chi2, 9.6);
+  r = chiSquare({1, 2, 3, 10, 10, 10, 4}, {1, 2, 3, 10, 10, 10, 0});
+  EXPECT_EQ(r.samplesInZeroCells, 4);
 }
 
 // Normalisation: 2π ∫ p dμ = 1. The quadrature error is ~1e-9 and float evaluation adds ~1e-7

@@ -10,72 +10,12 @@
 #include <vector>
 
 #include "shared/rng.h"
+#include "unit/stat_util.h"
 
 namespace {
 
-// ---- statistics helpers (double precision) ----
-
-// Regularized upper incomplete gamma Q(a, x) (Numerical Recipes §6.2); the χ² upper-tail p-value
-// with k degrees of freedom is Q(k/2, χ²/2).
-double gammaQ(double a, double x) {
-  if (x <= 0.0) return 1.0;
-  const double lnPre = -x + a * std::log(x) - std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, sum = 1.0 / a, del = sum;
-    for (int n = 0; n < 100000; ++n) {
-      ap += 1.0;
-      del *= x / ap;
-      sum += del;
-      if (std::fabs(del) < std::fabs(sum) * 1e-15) break;
-    }
-    return 1.0 - sum * std::exp(lnPre);
-  }
-  const double tiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::fabs(d) < tiny) d = tiny;
-    c = b + an / c;
-    if (std::fabs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::fabs(del - 1.0) < 1e-15) break;
-  }
-  return std::exp(lnPre) * h;
-}
-
-// χ² of counts against a uniform expectation; returns the p-value (dof = cells − 1).
-double uniformChiSquarePValue(const std::vector<double>& counts, double* chi2Out = nullptr) {
-  double n = 0.0;
-  for (double c : counts) n += c;
-  const double e = n / counts.size();
-  double chi2 = 0.0;
-  for (double c : counts) chi2 += (c - e) * (c - e) / e;
-  if (chi2Out) *chi2Out = chi2;
-  return gammaQ(0.5 * (counts.size() - 1), 0.5 * chi2);
-}
-
-// Pearson correlation coefficient of paired samples.
-double correlation(const std::vector<double>& x, const std::vector<double>& y) {
-  const size_t n = x.size();
-  double mx = 0.0, my = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    mx += x[i];
-    my += y[i];
-  }
-  mx /= n;
-  my /= n;
-  double sxy = 0.0, sxx = 0.0, syy = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    sxy += (x[i] - mx) * (y[i] - my);
-    sxx += (x[i] - mx) * (x[i] - mx);
-    syy += (y[i] - my) * (y[i] - my);
-  }
-  return sxy / std::sqrt(sxx * syy);
-}
+// Statistics helpers (gammaQ, equalCellsChiSquarePValue, correlation): tests/unit/stat_util.h.
+using namespace narval::test;
 
 struct Kat {
   uint32_t ctr[4];
@@ -176,7 +116,7 @@ TEST(RngUniform, OneStreamIsUniform) {
   const double sigma = std::sqrt(1.0 / 12.0 / n);
   EXPECT_NEAR(sum / n, 0.5, 4.0 * sigma);
   double chi2 = 0.0;
-  const double p = uniformChiSquarePValue(counts, &chi2);
+  const double p = equalCellsChiSquarePValue(counts, &chi2);
   EXPECT_GE(p, 1e-3 / 2) << "chi2 = " << chi2;
   RecordProperty("p_value_one_stream", std::to_string(p));
 }
@@ -195,7 +135,7 @@ TEST(RngUniform, FirstDrawsAcrossPixelsAreUniform) {
   }
   EXPECT_NEAR(sum / n, 0.5, 4.0 * std::sqrt(1.0 / 12.0 / n));
   double chi2 = 0.0;
-  const double p = uniformChiSquarePValue(counts, &chi2);
+  const double p = equalCellsChiSquarePValue(counts, &chi2);
   EXPECT_GE(p, 1e-3 / 2) << "chi2 = " << chi2;
 }
 
@@ -244,7 +184,7 @@ TEST(RngStreams, NeighboursAreUncorrelated) {
   EXPECT_LT(std::fabs(rSeed), bound) << "seed neighbours";
   EXPECT_LT(std::fabs(rLag), bound) << "consecutive draws";
   double chi2 = 0.0;
-  const double p = uniformChiSquarePValue(pairCounts, &chi2);
+  const double p = equalCellsChiSquarePValue(pairCounts, &chi2);
   EXPECT_GE(p, 1e-3) << "chi2 = " << chi2;
   RecordProperty("correlations", std::to_string(rPixel) + " " + std::to_string(rSample) + " " +
                                      std::to_string(rSeed) + " " + std::to_string(rLag));

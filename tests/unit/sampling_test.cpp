@@ -11,53 +11,14 @@
 #include <vector>
 
 #include "shared/sampling.h"
+#include "unit/stat_util.h"
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Regularized upper incomplete gamma Q(a, x) (Numerical Recipes §6.2); the χ² upper-tail p-value
-// with k degrees of freedom is Q(k/2, χ²/2).
-double gammaQ(double a, double x) {
-  if (x <= 0.0) return 1.0;
-  const double lnPre = -x + a * std::log(x) - std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, sum = 1.0 / a, del = sum;
-    for (int n = 0; n < 100000; ++n) {
-      ap += 1.0;
-      del *= x / ap;
-      sum += del;
-      if (std::fabs(del) < std::fabs(sum) * 1e-15) break;
-    }
-    return 1.0 - sum * std::exp(lnPre);
-  }
-  const double tiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::fabs(d) < tiny) d = tiny;
-    c = b + an / c;
-    if (std::fabs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::fabs(del - 1.0) < 1e-15) break;
-  }
-  return std::exp(lnPre) * h;
-}
-
-// χ² of counts against equal expected counts (cells of equal probability); p-value, dof = cells − 1.
-double equalCellsPValue(const std::vector<double>& counts, double* chi2Out) {
-  double n = 0.0;
-  for (double c : counts) n += c;
-  const double e = n / counts.size();
-  double chi2 = 0.0;
-  for (double c : counts) chi2 += (c - e) * (c - e) / e;
-  *chi2Out = chi2;
-  return gammaQ(0.5 * (counts.size() - 1), 0.5 * chi2);
-}
+// Statistics helpers (gammaQ, equalCellsChiSquarePValue): tests/unit/stat_util.h.
+using namespace narval::test;
 
 double angle01(double y, double x) {  // atan2 mapped to [0, 1)
   double a = std::atan2(y, x) / (2.0 * kPi);
@@ -101,7 +62,7 @@ TEST(SamplingUniformSphere, IsUnitAndUniform) {
   EXPECT_NEAR(sy / n, 0.0, bound);
   EXPECT_NEAR(sz / n, 0.0, bound);
   double chi2 = 0.0;
-  const double p = equalCellsPValue(counts, &chi2);
+  const double p = equalCellsChiSquarePValue(counts, &chi2);
   EXPECT_GE(p, kAlpha) << "chi2 = " << chi2;
   // End points: u1 = 0 -> z = +1 (north pole), u1 -> 1 -> z -> −1.
   EXPECT_EQ(sample_uniform_sphere(0.0f, 0.3f).z, 1.0f);
@@ -144,7 +105,7 @@ double diskChiSquarePValue(bool squareTheRadius, double* chi2) {
     const int ia = std::min(ka - 1, static_cast<int>(angle01(y, x) * ka));
     counts[ir * ka + ia] += 1.0;
   }
-  return equalCellsPValue(counts, chi2);
+  return equalCellsChiSquarePValue(counts, chi2);
 }
 
 TEST(SamplingConcentricDisk, IsUniformInArea) {

@@ -14,10 +14,8 @@
 
 #include "shared/accum.h"
 #include "shared/medium.h"
-// tracking.h calls sample_exponential but does not include shared/sampling.h (it compiles inside
-// pathtrace.h only because camera.h came first); included here until tracking.h includes it.
-#include "shared/sampling.h"
 #include "shared/tracking.h"
+#include "unit/stat_util.h"
 
 namespace {
 
@@ -41,25 +39,9 @@ nv_float4 grey4(float s) { return {s, s, s, 0.0f}; }
 float channel(vec3 v, int c) { return c == 0 ? v.x : (c == 1 ? v.y : v.z); }
 float channel4(nv_float4 v, int c) { return c == 0 ? v.x : (c == 1 ? v.y : v.z); }
 
-// Mean and standard error of the mean of a sample.
-struct MeanSe {
-  double mean = 0.0, se = 0.0;
-};
-struct Accumulator {
-  double n = 0.0, sum = 0.0, sum2 = 0.0;
-  void add(double x) {
-    n += 1.0;
-    sum += x;
-    sum2 += x * x;
-  }
-  MeanSe result() const {
-    MeanSe r;
-    r.mean = sum / n;
-    const double var = std::max(0.0, (sum2 - n * r.mean * r.mean) / (n - 1.0));
-    r.se = std::sqrt(var / n);
-    return r;
-  }
-};
+// Mean and standard error of the mean of a sample: tests/unit/stat_util.h.
+using narval::test::MeanAccumulator;
+using narval::test::MeanSe;
 
 // ---- intersect_box ----
 
@@ -283,7 +265,7 @@ TEST(TrackingRatio, UnbiasedOnARandomGrid) {
   ASSERT_LT(c.t0, c.t1);
   const double tau = opticalDepthOfDensity(c, 0.0f), tauShifted = opticalDepthOfDensity(c, 0.5f);
   const int n = 200000;
-  Accumulator acc[3];
+  MeanAccumulator acc[3];
   uint status = 0u;
   for (int i = 0; i < n; ++i) {
     rng_state rng = rng_init(9u, static_cast<uint>(i), 0u);
@@ -314,7 +296,7 @@ TEST(TrackingDelta, GreyHomogeneousEventProbabilities) {
   const grid_view h = {nullptr, 1, 1, 1};
   const int n = 1000000;
   int counts[3] = {0, 0, 0};
-  Accumulator dist;
+  MeanAccumulator dist;
   uint status = 0u;
   for (int i = 0; i < n; ++i) {
     rng_state rng = rng_init(3u, static_cast<uint>(i), 7u);
@@ -374,7 +356,7 @@ TEST(TrackingDelta, ChromaticSpectralTrackingIsUnbiasedPerChannel) {
   const medium_params m = makeMedium(sa, ss, 2.0f, 0, {1, 1, 1, 0});
   const grid_view h = {nullptr, 1, 1, 1};
   const int n = 1000000;
-  Accumulator esc[3], sca[3];
+  MeanAccumulator esc[3], sca[3];
   uint status = 0u;
   for (int i = 0; i < n; ++i) {
     rng_state rng = rng_init(4u, static_cast<uint>(i), 0u);
