@@ -109,6 +109,7 @@ int runRender(const RenderArgs& a) {
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
   const RenderResult r = renderPathtrace(rt, scene, hasGrid ? &grid : nullptr, options);
   bar.finish();
+  for (const std::string& w : r.warnings) std::cerr << "narval: warning: " << w << "\n";
 
   const RenderStats& s = r.stats;
   writeExr(out.string(), r.image,

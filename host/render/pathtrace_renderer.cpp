@@ -31,6 +31,7 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   const int W = scene.renderer.width, H = scene.renderer.height, spp = scene.renderer.spp;
 
   RenderResult result;
+  result.warnings = ds.warnings;
   RenderStats& st = result.stats;
   st.algorithm = "pathtrace";
   st.device = rt.selected.info.name;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "image/image.h"
 
@@ -31,6 +32,7 @@ struct RenderStats {
 struct RenderResult {
   ImageRGB image;
   RenderStats stats;
+  std::vector<std::string> warnings;  // from preparing the scene for the device
 };
 
 }  // namespace narval

@@ -261,3 +261,26 @@ TEST_F(Cli, MakeCloudWritesTheGeneratedGrid) {
 
 }  // namespace
 }  // namespace narval
+
+namespace narval {
+namespace {
+
+// The dragon's file transform rotates and shears: in the default "unit" grid space that part is
+// dropped, and the user is told so (DESIGN.md, physics conventions); "file" keeps it, silently.
+TEST_F(Cli, DragonTransformWarningInUnitGridSpaceOnly) {
+  const char* env = std::getenv("NARVAL_DATA_DIR");
+  const fs::path dragon = fs::path(env ? env : NARVAL_DEFAULT_DATA_DIR) / "vpt_dragon_with_xform.vdb";
+  if (!fs::exists(dragon)) GTEST_SKIP() << "real data absent: " << dragon << " (set NARVAL_DATA_DIR)";
+  write("scene.json", listing41(dragon.string()));
+  RunResult r = run("render scene.json --resolution 8x4 --spp 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err,
+            "narval: warning: scene.json: materials[1].gridSpace: the grid's file transform rotates or shears; "
+            "\"unit\" grid space drops it (set \"gridSpace\": \"file\" to keep it)\n");
+  r = run("render scene.json --resolution 8x4 --spp 1 --set materials.1.gridSpace=file");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+}
+
+}  // namespace
+}  // namespace narval
