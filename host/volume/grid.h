@@ -29,6 +29,10 @@ DenseGrid loadGrid(const std::string& path, const std::string& gridName = "densi
 DenseGrid loadVdb(const std::string& path, const std::string& gridName);
 DenseGrid loadVol(const std::string& path);
 
+// loadVdb and vdbGridNames read the file in a forked child process on Linux (OpenVDB 10's reader
+// aborts or corrupts memory on some corrupt files; the child's death becomes an InputError here).
+// NARVAL_VDB_IN_PROCESS=1 reads in-process instead (debuggers, memory checkers).
+//
 // The names of the float grids in a .vdb file (for error messages and `narval info`).
 std::vector<std::string> vdbGridNames(const std::string& path);
 

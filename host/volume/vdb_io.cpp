@@ -3,11 +3,13 @@
 #include "volume/grid.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -18,10 +20,12 @@
 #include <utility>
 #include <vector>
 
-#if defined(__unix__) || defined(__APPLE__)
+#if defined(__linux__)
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #endif
@@ -29,6 +33,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/io/Stream.h>
 #include <openvdb/tools/Dense.h>
+#include <tbb/task_arena.h>
 
 #include "scene/input_error.h"
 
@@ -55,14 +60,23 @@ void requireReadableFile(const std::string& path) {
 
 std::string quoted(const std::string& name) { return "'" + name + "'"; }
 
+// An exception's text made fit for a one-line message (OpenVDB's can span lines).
+std::string oneLine(const char* what) {
+  std::string s(what);
+  for (char& c : s) {
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  }
+  return s;
+}
+
 struct GridEntry {
   std::string name;
   std::string valueType;  // "float", "vec3s", ...
   bool isFloat = false;
 };
 
-// Opens `path` (no delayed loading: no memory map, every read goes through the stream and fails
-// cleanly on a truncated file) and lists its grids.
+// Opens `path` (no delayed loading, so no memory map) and lists its grids from their metadata
+// (names, types, transforms: no tree data is read).
 std::vector<GridEntry> listGrids(openvdb::io::File& file, const std::string& path) {
   std::vector<GridEntry> out;
   try {
@@ -72,7 +86,7 @@ std::vector<GridEntry> listGrids(openvdb::io::File& file, const std::string& pat
       out.push_back({g->getName(), g->valueType(), g->isType<openvdb::FloatGrid>()});
     }
   } catch (const std::exception& e) {
-    throw inputError(path, "", std::string("not a readable OpenVDB file (") + e.what() + ")");
+    throw inputError(path, "", "not a readable OpenVDB file (" + oneLine(e.what()) + ")");
   }
   return out;
 }
@@ -86,54 +100,6 @@ openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
   in.exceptions(std::ios::failbit | std::ios::badbit);
   openvdb::io::Stream stream(in, /*delayLoad=*/false);
   return stream.getGrids();
-}
-
-// OpenVDB 10's readers trust the sizes and flags they find in the file: corrupted bytes inside
-// compressed leaf data (a size field larger than its buffer, a bad mask flag) overflow a heap
-// buffer in io::readCompressedValues and abort the process ("double free or corruption") or,
-// worse, corrupt memory silently. That cannot be caught in-process, so a forked child reads the
-// file first (single-threaded, nothing shared) and reports whether it survived. True: the child
-// died on a signal. False: it finished (exceptions included: the parent reports those itself) or
-// the check could not run (no fork, a child stuck past the time limit: it is killed and the
-// parent reads the file as it would have anyway).
-bool readerCrashes(const std::string& path) {
-#if defined(__unix__) || defined(__APPLE__)
-  std::error_code ec;
-  const uintmax_t size = fs::file_size(path, ec);
-  const pid_t pid = ::fork();
-  if (pid < 0) return false;
-  if (pid == 0) {
-    // Child: no core file, no allocator diagnostics on the parent's terminal, no exit handlers.
-    struct rlimit noCore{0, 0};
-    ::setrlimit(RLIMIT_CORE, &noCore);
-    const int devNull = ::open("/dev/null", O_WRONLY);
-    if (devNull >= 0) ::dup2(devNull, 2);
-    try {
-      readAllGrids(path);
-    } catch (...) {
-    }
-    ::_exit(0);
-  }
-  // 60 s plus 1 s per 10 MB: far beyond any healthy read.
-  const double limit = 60.0 + double(ec ? 0 : size) / 1e7;
-  const auto start = std::chrono::steady_clock::now();
-  int status = 0;
-  for (useconds_t nap = 200;; nap = std::min<useconds_t>(nap * 2, 20000)) {
-    const pid_t r = ::waitpid(pid, &status, WNOHANG);
-    if (r == pid) return WIFSIGNALED(status);
-    if (r < 0 && errno != EINTR) return false;
-    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > limit) {
-      ::kill(pid, SIGKILL);
-      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-      }
-      return false;
-    }
-    ::usleep(nap);
-  }
-#else
-  (void)path;
-  return false;
-#endif
 }
 
 std::string describeGrids(const std::vector<GridEntry>& grids) {
@@ -160,7 +126,7 @@ void writeAtomically(const std::string& path, WriteFn&& write) {
   } catch (const std::exception& e) {
     std::error_code ec;
     fs::remove(tmp, ec);
-    throw inputError(path, "", std::string("cannot write the file (") + e.what() + ")");
+    throw inputError(path, "", "cannot write the file (" + oneLine(e.what()) + ")");
   }
   std::error_code ec;
   fs::rename(tmp, path, ec);
@@ -179,49 +145,37 @@ void writeGrids(const std::string& path, const openvdb::GridPtrVec& grids) {
   });
 }
 
-}  // namespace
+// Where decodeVdb puts its result: the dense values go to `allocate(n)`'s n floats.
+struct Decoded {
+  int nx = 0, ny = 0, nz = 0;
+  std::array<float, 12> indexToWorld{};
+  bool scaleTranslate = true;
+};
 
-std::vector<std::string> vdbGridNames(const std::string& path) {
-  initOpenVdb();
-  requireReadableFile(path);
-  openvdb::io::File file(path);
-  std::vector<std::string> names;
-  for (const GridEntry& g : listGrids(file, path)) {
-    if (g.isFloat) names.push_back(g.name);
-  }
-  return names;
-}
-
-DenseGrid loadVdb(const std::string& path, const std::string& gridName) {
-  initOpenVdb();
-  requireReadableFile(path);
-  openvdb::io::File file(path);
-  const std::vector<GridEntry> grids = listGrids(file, path);
-
-  const auto entry = std::find_if(grids.begin(), grids.end(),
-                                  [&](const GridEntry& g) { return g.name == gridName; });
-  if (entry == grids.end()) {
-    throw inputError(path, "grid", "no grid named " + quoted(gridName) + " (" + describeGrids(grids) + ")");
-  }
-  if (!entry->isFloat) {
-    std::string floats;
-    for (const GridEntry& g : grids) {
-      if (g.isFloat) floats += (floats.empty() ? "" : ", ") + g.name;
+// Everything that parses the file: grid lookup, type and transform checks, the active bounding
+// box, the size limit and the dense copy. Throws InputError (the full one-line message).
+template <typename Allocate>
+Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate&& allocate, bool serial) {
+  {
+    openvdb::io::File file(path);
+    const std::vector<GridEntry> grids = listGrids(file, path);
+    const auto entry =
+        std::find_if(grids.begin(), grids.end(), [&](const GridEntry& g) { return g.name == gridName; });
+    if (entry == grids.end()) {
+      throw inputError(path, "grid", "no grid named " + quoted(gridName) + " (" + describeGrids(grids) + ")");
     }
-    throw inputError(path, "grid",
-                     quoted(gridName) + " is a " + entry->valueType + " grid; narval needs a float grid (" +
-                         (floats.empty() ? std::string("the file has none") : "float grids in the file: " + floats) +
-                         ")");
+    if (!entry->isFloat) {
+      std::string floats;
+      for (const GridEntry& g : grids) {
+        if (g.isFloat) floats += (floats.empty() ? "" : ", ") + g.name;
+      }
+      throw inputError(path, "grid",
+                       quoted(gridName) + " is a " + entry->valueType + " grid; narval needs a float grid (" +
+                           (floats.empty() ? std::string("the file has none") : "float grids in the file: " + floats) +
+                           ")");
+    }
   }
 
-  file.close();
-
-  // The grid data is read through our own stream with exceptions on (see readAllGrids), after a
-  // forked child has survived reading the same file (see readerCrashes).
-  if (readerCrashes(path)) {
-    throw inputError(path, "grid", "cannot read " + quoted(gridName) +
-                                       " (the file is corrupt: OpenVDB's reader crashes on it)");
-  }
   openvdb::FloatGrid::Ptr grid;
   try {
     const openvdb::GridPtrVecPtr all = readAllGrids(path);  // keep it alive through the loop
@@ -236,7 +190,7 @@ DenseGrid loadVdb(const std::string& path, const std::string& gridName) {
                                        " (the file is truncated or corrupt: a read ran past its end)");
   } catch (const std::exception& e) {
     throw inputError(path, "grid", "cannot read " + quoted(gridName) + " (the file is truncated or corrupt: " +
-                                       e.what() + ")");
+                                       oneLine(e.what()) + ")");
   }
   if (!grid) throw inputError(path, "grid", "cannot read " + quoted(gridName) + " as a float grid");
 
@@ -252,31 +206,36 @@ DenseGrid loadVdb(const std::string& path, const std::string& gridName) {
   if (grid->activeVoxelCount() == 0 || bbox.empty()) {
     throw inputError(path, "grid", quoted(gridName) + " has no active voxels");
   }
-  const openvdb::Coord dim = bbox.dim();
-  const uint64_t voxels = uint64_t(dim.x()) * uint64_t(dim.y()) * uint64_t(dim.z());
-  const uint64_t bytes = voxels * sizeof(float);
+  // In 64 bits: a corrupt tree can span more than 2^31 voxels per axis (Coord::dim would wrap).
+  const int64_t dim[3] = {int64_t(bbox.max().x()) - bbox.min().x() + 1, int64_t(bbox.max().y()) - bbox.min().y() + 1,
+                          int64_t(bbox.max().z()) - bbox.min().z() + 1};
   constexpr uint64_t kMaxBytes = uint64_t(1) << 31;
-  if (bytes > kMaxBytes) {
+  constexpr int64_t kMaxDim = int64_t(kMaxBytes / sizeof(float));
+  const bool tooBig = dim[0] > kMaxDim || dim[1] > kMaxDim || dim[2] > kMaxDim ||
+                      uint64_t(dim[0]) * uint64_t(dim[1]) > kMaxBytes ||
+                      uint64_t(dim[0]) * uint64_t(dim[1]) * uint64_t(dim[2]) * sizeof(float) > kMaxBytes;
+  if (tooBig) {
+    const bool showCount = dim[0] < (1 << 20) && dim[1] < (1 << 20) && dim[2] < (1 << 20);
+    const uint64_t voxels = uint64_t(dim[0]) * uint64_t(dim[1]) * uint64_t(dim[2]);
     throw inputError(path, "grid",
-                     quoted(gridName) + " active bounding box " + dimsString(dim.x(), dim.y(), dim.z()) + " = " +
-                         std::to_string(voxels) + " voxels needs " + std::to_string(bytes >> 20) +
-                         " MiB as dense floats, over the 2048 MiB limit");
+                     quoted(gridName) + " active bounding box " + dimsString(dim[0], dim[1], dim[2]) +
+                         (showCount ? " = " + std::to_string(voxels) + " voxels needs " +
+                                          std::to_string((voxels * sizeof(float)) >> 20) + " MiB as dense floats,"
+                                    : " is") +
+                         " over the 2048 MiB limit");
   }
 
-  DenseGrid out;
-  out.nx = dim.x();
-  out.ny = dim.y();
-  out.nz = dim.z();
-  out.source = path;
-  out.data.assign(voxels, 0.0f);
+  Decoded out;
+  out.nx = int(dim[0]);
+  out.ny = int(dim[1]);
+  out.nz = int(dim[2]);
   {
-    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, out.data.data());
-    openvdb::tools::copyToDense(*grid, dense, /*serial=*/false);
+    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, allocate(size_t(dim[0] * dim[1] * dim[2])));
+    openvdb::tools::copyToDense(*grid, dense, serial);
   }
 
   // Our index u (voxel i covers [i, i+1]) -> vdb index ijk = u - 0.5 + bbox.min -> world.
   const openvdb::Vec3d shift(bbox.min().x() - 0.5, bbox.min().y() - 0.5, bbox.min().z() - 0.5);
-  bool diagonal = true;
   double maxDiag = 0.0;
   for (int r = 0; r < 3; ++r) maxDiag = std::max(maxDiag, std::abs(m[r][r]));
   for (int r = 0; r < 3; ++r) {
@@ -284,12 +243,219 @@ DenseGrid loadVdb(const std::string& path, const std::string& gridName) {
     for (int c = 0; c < 3; ++c) {
       out.indexToWorld[size_t(r * 4 + c)] = float(m[c][r]);
       t += shift[c] * m[c][r];
-      if (r != c && std::abs(m[c][r]) > 1e-9 * maxDiag) diagonal = false;
+      if (r != c && std::abs(m[c][r]) > 1e-9 * maxDiag) out.scaleTranslate = false;
     }
     out.indexToWorld[size_t(r * 4 + 3)] = float(t);
   }
-  out.fileTransformIsScaleTranslate = diagonal;
+  return out;
+}
 
+std::vector<std::string> floatGridNames(const std::string& path) {
+  openvdb::io::File file(path);
+  std::vector<std::string> names;
+  for (const GridEntry& g : listGrids(file, path)) {
+    if (g.isFloat) names.push_back(g.name);
+  }
+  return names;
+}
+
+#if defined(__linux__)
+// OpenVDB 10's readers trust the sizes and flags they find in a file. Corrupted bytes inside
+// compressed leaf data (a size field larger than its buffer, a wrong mask flag) overflow a heap
+// buffer in io::readCompressedValues / io::bloscFromStream: that aborts the process ("double free
+// or corruption") or, worse, corrupts the heap silently and crashes it later. A corrupted length
+// in the metadata makes it build (and zero) a string of up to 4 GiB. None of this can be caught,
+// so every read of a file's contents runs in a forked child that shares nothing with us but a
+// memfd: it writes a result record (and the dense values after the first page) there. A child
+// that dies on a signal, or runs past a time limit, is reported as a corrupt file. The child runs
+// single-threaded (a one-slot TBB arena and a serial copy: the parent's TBB workers do not exist
+// in it), writes nothing to our stderr and leaves with _exit. NARVAL_VDB_IN_PROCESS=1 reads in
+// this process instead (for debuggers and memory checkers).
+struct ChildRecord {
+  uint64_t magic;
+  int32_t ok;  // 1: result (Decoded, or names in the data area); 0: InputError message; -1: other error
+  uint32_t payloadBytes;  // names: bytes after the first page
+  Decoded decoded;
+  char message[3072];
+};
+constexpr uint64_t kRecordMagic = 0x6e617276616c7664ull;  // "narvalvd"
+constexpr size_t kDataOffset = 4096;
+static_assert(sizeof(ChildRecord) <= kDataOffset, "the record fits in the first page");
+
+struct Fd {
+  int fd = -1;
+  Fd() = default;
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// Runs `work(fd, record)` in a child; returns false (nothing ran) when no child can be used.
+// After a true return `mem` holds what the child wrote and `rec` its record (ok == 1); InputErrors
+// from the child, crashes and time-outs are thrown here as "PATH: grid: CANNOT (...)".
+template <typename Work>
+bool runInChild(const std::string& path, const std::string& cannot, Work&& work, Fd& mem, ChildRecord& rec) {
+  if (std::getenv("NARVAL_VDB_IN_PROCESS")) return false;
+  mem.fd = ::memfd_create("narval-vdb", MFD_CLOEXEC);
+  if (mem.fd < 0) return false;
+  const pid_t pid = ::fork();
+  if (pid < 0) return false;
+  if (pid == 0) {
+    struct rlimit noCore{0, 0};
+    ::setrlimit(RLIMIT_CORE, &noCore);
+    const int devNull = ::open("/dev/null", O_WRONLY);
+    if (devNull >= 0) ::dup2(devNull, 2);  // allocator diagnostics are ours to report
+    ChildRecord out{};
+    out.magic = kRecordMagic;
+    try {
+      tbb::task_arena arena(1, 1);
+      arena.execute([&] { work(mem.fd, out); });
+      out.ok = 1;
+    } catch (const std::exception& e) {
+      out.ok = dynamic_cast<const InputError*>(&e) ? 0 : -1;
+      std::snprintf(out.message, sizeof(out.message), "%s", oneLine(e.what()).c_str());
+    }
+    // The record goes last: a child that dies before this leaves no magic behind.
+    if (::pwrite(mem.fd, &out, sizeof(out), 0) != ssize_t(sizeof(out))) ::_exit(3);
+    ::_exit(0);
+  }
+
+  // A healthy read takes well under a second for these files; the limit is for pathological ones.
+  std::error_code ec;
+  const uintmax_t size = fs::file_size(path, ec);
+  const double limitS = 120.0 + double(ec ? 0 : size) / 5e6;
+  const auto start = std::chrono::steady_clock::now();
+  int status = 0;
+  for (useconds_t nap = 100;; nap = std::min<useconds_t>(nap * 2, 20000)) {
+    const pid_t r = ::waitpid(pid, &status, WNOHANG);
+    if (r == pid) break;
+    if (r < 0 && errno != EINTR) throw inputError(path, "grid", cannot + " (lost the reader process)");
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > limitS) {
+      ::kill(pid, SIGKILL);
+      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      throw inputError(path, "grid", cannot + " (reading took more than " + std::to_string(int(limitS)) +
+                                         " s: the file is probably corrupt)");
+    }
+    ::usleep(nap);
+  }
+  if (WIFSIGNALED(status)) {
+    throw inputError(path, "grid", cannot + " (the file is corrupt: OpenVDB's reader crashed on it, " +
+                                       strsignal(WTERMSIG(status)) + ")");
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
+      ::pread(mem.fd, &rec, sizeof(rec), 0) != ssize_t(sizeof(rec)) || rec.magic != kRecordMagic) {
+    throw inputError(path, "grid", cannot + " (the reader process failed)");
+  }
+  rec.message[sizeof(rec.message) - 1] = '\0';
+  if (rec.ok == 0) throw InputError(rec.message);
+  if (rec.ok != 1) throw inputError(path, "grid", cannot + " (" + rec.message + ")");
+  return true;
+}
+
+bool decodeInChild(const std::string& path, const std::string& gridName, DenseGrid& out) {
+  const std::string cannot = "cannot read " + quoted(gridName);
+  Fd mem;
+  ChildRecord rec{};
+  auto work = [&](int fd, ChildRecord& result) {
+    void* map = nullptr;
+    size_t mapBytes = 0;
+    result.decoded = decodeVdb(
+        path, gridName,
+        [&](size_t n) {
+          mapBytes = kDataOffset + n * sizeof(float);
+          if (::ftruncate(fd, off_t(mapBytes)) != 0) throw std::bad_alloc();
+          map = ::mmap(nullptr, mapBytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+          if (map == MAP_FAILED) throw std::bad_alloc();
+          return reinterpret_cast<float*>(static_cast<char*>(map) + kDataOffset);
+        },
+        /*serial=*/true);
+    if (map) ::munmap(map, mapBytes);
+  };
+  if (!runInChild(path, cannot, work, mem, rec)) return false;
+
+  const Decoded& d = rec.decoded;
+  const uint64_t voxels = uint64_t(d.nx) * uint64_t(d.ny) * uint64_t(d.nz);
+  struct stat st {};
+  if (d.nx <= 0 || d.ny <= 0 || d.nz <= 0 || voxels * sizeof(float) > (uint64_t(1) << 31) ||
+      ::fstat(mem.fd, &st) != 0 || uint64_t(st.st_size) != kDataOffset + voxels * sizeof(float)) {
+    throw inputError(path, "grid", cannot + " (the reader process returned an inconsistent result)");
+  }
+  out.nx = d.nx;
+  out.ny = d.ny;
+  out.nz = d.nz;
+  out.indexToWorld = d.indexToWorld;
+  out.fileTransformIsScaleTranslate = d.scaleTranslate;
+  out.data.resize(voxels);
+  void* map = ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_SHARED, mem.fd, 0);
+  if (map == MAP_FAILED) throw inputError(path, "grid", cannot + " (cannot map the reader's result)");
+  std::memcpy(out.data.data(), static_cast<const char*>(map) + kDataOffset, voxels * sizeof(float));
+  ::munmap(map, size_t(st.st_size));
+  return true;
+}
+
+bool namesInChild(const std::string& path, std::vector<std::string>& names) {
+  Fd mem;
+  ChildRecord rec{};
+  auto work = [&](int fd, ChildRecord& result) {
+    std::string joined;
+    for (const std::string& n : floatGridNames(path)) joined.append(n).push_back('\0');
+    result.payloadBytes = uint32_t(joined.size());
+    if (::pwrite(fd, joined.data(), joined.size(), off_t(kDataOffset)) != ssize_t(joined.size())) {
+      throw std::runtime_error("cannot pass the grid names back");
+    }
+  };
+  if (!runInChild(path, "cannot list the grids", work, mem, rec)) return false;
+  std::string joined(rec.payloadBytes, '\0');
+  if (::pread(mem.fd, joined.data(), joined.size(), off_t(kDataOffset)) != ssize_t(joined.size())) {
+    throw inputError(path, "grid", "cannot list the grids (the reader process returned an inconsistent result)");
+  }
+  for (size_t start = 0; start < joined.size();) {
+    const size_t end = joined.find('\0', start);
+    names.push_back(joined.substr(start, end - start));
+    start = end + 1;
+  }
+  return true;
+}
+#endif
+
+}  // namespace
+
+std::vector<std::string> vdbGridNames(const std::string& path) {
+  initOpenVdb();
+  requireReadableFile(path);
+#if defined(__linux__)
+  std::vector<std::string> names;
+  if (namesInChild(path, names)) return names;
+#endif
+  return floatGridNames(path);
+}
+
+DenseGrid loadVdb(const std::string& path, const std::string& gridName) {
+  initOpenVdb();
+  requireReadableFile(path);
+  DenseGrid out;
+  out.source = path;
+  bool done = false;
+#if defined(__linux__)
+  done = decodeInChild(path, gridName, out);
+#endif
+  if (!done) {
+    const Decoded d = decodeVdb(
+        path, gridName,
+        [&](size_t n) {
+          out.data.assign(n, 0.0f);
+          return out.data.data();
+        },
+        /*serial=*/false);
+    out.nx = d.nx;
+    out.ny = d.ny;
+    out.nz = d.nz;
+    out.indexToWorld = d.indexToWorld;
+    out.fileTransformIsScaleTranslate = d.scaleTranslate;
+  }
   checkDensityValues(out, "grid", quoted(gridName) + " has ");
   return out;
 }

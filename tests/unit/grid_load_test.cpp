@@ -198,6 +198,40 @@ TEST(VdbRealData, TruncatedOrCorruptFilesAreCleanErrors) {
   EXPECT_EQ(msg.rfind(cut + ": ", 0), 0u) << msg;
 }
 
+// Random byte flips in Blosc-compressed leaf data make OpenVDB 10's reader overflow heap buffers
+// (an abort, or silent heap corruption that crashes later); loadVdb decodes in a child process so
+// that this process survives and reports the file. Each corrupted copy either loads (the flips hit
+// nothing that matters) or fails with an InputError naming the file, and nothing crashes later.
+TEST(VdbRealData, CorruptedCompressedFilesNeverCrashTheProcess) {
+  REQUIRE_DATA(path, "vpt_dragon_with_xform.vdb");
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  TempDir dir;
+  const std::string bad = dir.file("bad.vdb");
+  int failed = 0;
+  for (uint32_t s = 0; s < 40; ++s) {
+    std::string b = bytes;
+    uint32_t h = 2166136261u * (s + 1);
+    for (int k = 0; k < 20; ++k) {
+      h = h * 1664525u + 1013904223u;
+      const size_t pos = h % b.size();
+      b[pos] = char(b[pos] ^ char(1 + (h >> 24) % 255));
+    }
+    writeText(bad, b);
+    try {
+      narval::loadVdb(bad, "density");
+    } catch (const InputError& e) {
+      ++failed;
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(bad + ": ", 0), 0u) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+  EXPECT_GT(failed, 30);
+  // The process is intact: the genuine file still loads.
+  EXPECT_EQ(narval::loadVdb(path, "density").nx, 141);
+}
+
 // ---- .vdb written by narval ----
 
 // nx x ny x nz with zeros in the first `zx` x-slices, `zy` y-rows and `zz` z-slices, distinct
