@@ -663,7 +663,9 @@ TEST_F(SceneFiles, ShippedScenesParse) {
   EXPECT_EQ(cloud.renderer.height, 360);
   EXPECT_EQ(cloud.renderer.spp, 64);
   EXPECT_EQ(cloud.renderer.bounces, 8);
-  EXPECT_EQ(cloud.background, (Vec3f{0.05f, 0.07f, 0.1f}));
+  EXPECT_EQ(cloud.background, (Vec3f{0.07f, 0.1f, 0.17f}));
+  // A key light from the upper left front.
+  EXPECT_EQ(cloud.primitives[2].materialName, "key");
 
   // listing_4_1.json is Listing 4.1 with only the grid's path changed.
   std::string listing = kListing41;
