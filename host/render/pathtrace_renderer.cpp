@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "render/device_grid.h"
-#include "render/scene_upload.h"
+#include "render/device_scene.h"
+#include "render/render_common.h"
 
 namespace narval {
 namespace {
@@ -13,8 +13,6 @@ namespace {
 double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
-
-size_t roundUp(size_t n, size_t m) { return (n + m - 1) / m * m; }
 
 }  // namespace
 
@@ -27,52 +25,32 @@ int pathtraceSamplesPerPass(int width, int height, int spp) {
 RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
                              const RenderOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
-  const DeviceScene ds = buildDeviceScene(scene, grid);
   const int W = scene.renderer.width, H = scene.renderer.height, spp = scene.renderer.spp;
+  const DeviceSceneBuffers dev(rt, scene, grid);
 
   RenderResult result;
-  result.warnings = ds.warnings;
+  result.warnings = dev.scene.warnings;
+  result.stats = initialStats("pathtrace", rt, scene);
   RenderStats& st = result.stats;
-  st.algorithm = "pathtrace";
-  st.device = rt.selected.info.name;
-  st.width = W;
-  st.height = H;
-  st.spp = spp;
-  st.bounces = scene.renderer.bounces;
 
-  cl::Program program = buildProgram(rt, "pathtrace.cl", ds.buildOptions, nullptr, &st.programFromCache);
+  cl::Program program = buildProgram(rt, "pathtrace.cl", dev.scene.buildOptions, nullptr, &st.programFromCache);
   cl::Kernel kernel(program, "pathtrace");
 
   const size_t pixels = size_t(W) * size_t(H);
-  cl::Buffer sceneBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(scene_params),
-                      const_cast<scene_params*>(&ds.params));
-  cl::Buffer lightBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(light_params) * ds.lights.size(),
-                      const_cast<light_params*>(ds.lights.data()));
   cl::Buffer sumBuf(rt.context, CL_MEM_READ_WRITE, pixels * 4 * sizeof(float));
   cl::Buffer compBuf(rt.context, CL_MEM_READ_WRITE, pixels * 4 * sizeof(float));
   cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
   rt.queue.enqueueFillBuffer(sumBuf, 0.0f, 0, pixels * 4 * sizeof(float));
   rt.queue.enqueueFillBuffer(compBuf, 0.0f, 0, pixels * 4 * sizeof(float));
   rt.queue.enqueueFillBuffer(statusBuf, cl_uint(0), 0, sizeof(cl_uint));
-
-  kernel.setArg(0, sceneBuf);
-  kernel.setArg(1, lightBuf);
-  cl::Image3D gridImage;
-  if (ds.grid) {
-    gridImage = uploadGrid(rt, *ds.grid);
-    kernel.setArg(2, gridImage);
-  } else {
-    kernel.setArg(2, cl_int(0));
-  }
+  dev.bind(kernel);
   kernel.setArg(3, sumBuf);
   kernel.setArg(4, compBuf);
   kernel.setArg(7, statusBuf);
   rt.queue.finish();
   st.buildSeconds = secondsSince(t0);
 
-  // OpenCL 1.2 wants the global size to be a multiple of the local size: pad, the kernel guards.
-  const size_t lx = size_t(std::max(1, options.localSizeX)), ly = size_t(std::max(1, options.localSizeY));
-  const cl::NDRange global(roundUp(size_t(W), lx), roundUp(size_t(H), ly)), local(lx, ly);
+  const cl::NDRange global = paddedGlobalRange(W, H, options), local = localRange(options);
   const int perPass = pathtraceSamplesPerPass(W, H, spp);
   const auto tLoop = std::chrono::steady_clock::now();
   for (int done = 0; done < spp;) {
@@ -82,8 +60,7 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
     cl::Event ev;
     rt.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &ev);
     ev.wait();
-    st.kernelSeconds += double(ev.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
-                               ev.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-9;
+    st.kernelSeconds += eventSeconds(ev);
     done += count;
     ++st.passes;
     if (options.progress) options.progress(done, spp);
@@ -94,18 +71,7 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   st.seconds = secondsSince(tLoop);
   st.samplesPerSecond = st.seconds > 0 ? double(pixels) * spp / st.seconds : 0.0;
 
-  ImageRGB& img = result.image;
-  img.width = W;
-  img.height = H;
-  img.rgb.resize(pixels * 3);
-  for (size_t i = 0; i < pixels; ++i) {
-    bool finite = true;
-    for (int c = 0; c < 3; ++c) {
-      img.rgb[i * 3 + c] = sums[i * 4 + c] / float(spp);
-      finite = finite && std::isfinite(img.rgb[i * 3 + c]);
-    }
-    st.nanPixels += finite ? 0 : 1;
-  }
+  result.image = imageFromRgba(sums, W, H, float(spp), &st.nanPixels);
   return result;
 }
 

@@ -64,6 +64,22 @@ typedef struct medium_params {
   int grey;             /* 1: sigma_a and sigma_s are equal in all channels (analogue tracking) */
 } medium_params;
 
+/* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
+typedef struct realtime_params {
+  int steps;            /* raymarch: samples over the view ray's segment inside the box */
+  int shadow_steps;     /* raymarch: samples per shadow ray; lobe: per transmittance integral */
+  int octaves;          /* raymarch multiple-scattering octaves (Wrenninge et al. 2013); 1 = off */
+  float octave_a;       /* scattering scale per octave */
+  float octave_b;       /* extinction scale per octave (a <= b conserves energy) */
+  float octave_c;       /* phase anisotropy scale per octave */
+  float depth_factor;   /* lobe: centre at depth_factor mean free paths past the first hit */
+  float lobe_radius;    /* lobe: world units */
+  int lobe_points;      /* lobe: directions in the lobe_directions buffer */
+  int pad0;
+  int pad1;
+  int pad2;
+} realtime_params;
+
 typedef struct scene_params {
   camera_params camera;
   medium_params medium;

@@ -1,0 +1,27 @@
+// render_common.h: pieces every render driver shares (launch geometry, stats, read-back).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cl/cl_runtime.h"
+#include "render/render_types.h"
+#include "scene/scene.h"
+
+namespace narval {
+
+// Statistics with the fields every algorithm fills the same way.
+RenderStats initialStats(const std::string& algorithm, const ClRuntime& rt, const Scene& scene);
+
+// OpenCL 1.2 wants the global size to be a multiple of the local size: pad; kernels guard.
+cl::NDRange paddedGlobalRange(int width, int height, const RenderOptions& options);
+cl::NDRange localRange(const RenderOptions& options);
+
+// RGBA floats (as the kernels write them) divided by `divisor` into an RGB image; counts the
+// pixels with a non-finite channel into *nanPixels.
+ImageRGB imageFromRgba(const std::vector<float>& rgba, int width, int height, float divisor, long long* nanPixels);
+
+// Seconds between an event's start and end (profiling queue).
+double eventSeconds(const cl::Event& e);
+
+}  // namespace narval
