@@ -5,12 +5,11 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "image/image.h"
+#include "test_support.h"
 #include "volume/grid.h"
 
 namespace fs = std::filesystem;
@@ -23,24 +22,13 @@ struct RunResult {
   std::string out, err;
 };
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using test::listing41Json;
+using test::readFile;
+using test::realDataPath;
 
+// Each test runs narval in a fresh folder of its own.
 class Cli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("narval_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // Runs `narval ARGS` in the test's folder; stdout and stderr captured to files.
   RunResult run(const std::string& args) {
     const std::string cmd = "cd '" + dir_.string() + "' && '" + std::string(NARVAL_BINARY) + "' " + args +
@@ -48,90 +36,27 @@ class Cli : public ::testing::Test {
     const int status = std::system(cmd.c_str());
     RunResult r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(dir_ / "stdout.txt");
-    r.err = slurp(dir_ / "stderr.txt");
+    r.out = readFile(dir_ / "stdout.txt");
+    r.err = readFile(dir_ / "stderr.txt");
     fs::remove(dir_ / "stdout.txt");
     fs::remove(dir_ / "stderr.txt");
     return r;
   }
-  void write(const std::string& name, const std::string& text) { std::ofstream(dir_ / name) << text; }
+  void write(const std::string& name, const std::string& text) { test::writeFile(dir_ / name, text); }
   // Files in the folder other than the inputs the test wrote.
   std::vector<std::string> outputs(const std::vector<std::string>& inputs) {
     std::vector<std::string> found;
-    for (const auto& e : fs::directory_iterator(dir_)) {
-      const std::string n = e.path().filename().string();
+    for (const std::string& n : tmp_.entries())
       if (std::find(inputs.begin(), inputs.end(), n) == inputs.end()) found.push_back(n);
-    }
     return found;
   }
-  fs::path dir_;
+  test::TempDir tmp_{"narval_cli"};
+  const fs::path dir_ = tmp_.path();
 };
-
-// Listing 4.1 of the dissertation, verbatim but for the volume path.
-std::string listing41(const std::string& path) {
-  return R"({
-  "materials": [
-    {
-      "name": "emitter",
-      "type": "emitter",
-      "albedo": [20, 20, 20]
-    },
-    {
-      "name": "cloudVolMat",
-      "type": "volume",
-      "scattering": [1.1, 1.1, 1.1],
-      "absorption": [0.01, 0.01, 0.01],
-      "phaseFunction": "hg",
-      "g": 0.9,
-      "path": ")" + path + R"(",
-      "density": 10
-    }
-  ],
-  "primitives": [
-    {
-      "name": "rectLight",
-      "type": "rectangle",
-      "transform": {
-        "position": [0, 0, 80],
-        "scale": [150, 100, 1],
-        "rotation": [0, 0, 0]
-      },
-      "materialName": "emitter"
-    },
-    {
-      "name": "cloud",
-      "type": "volume",
-      "transform": {
-        "position": [0.0, 0, 0],
-        "scale": [15.9, 9.51, 13.5],
-        "rotation": [0, 0, 0]
-      },
-      "materialName": "cloudVolMat"
-    }
-  ],
-  "camera": {
-    "position": [0, 0, -17],
-    "lookAt": [0, 0, 0],
-    "up": [0, 1, 0],
-    "speed": 5,
-    "vfov": 45,
-    "aperture": 0.0001,
-    "focus": 1
-  },
-  "renderer": {
-    "resolution": [1200, 600],
-    "spp": 1000,
-    "bounces": 3,
-    "HDR": true,
-    "toneMapping": true
-  }
-}
-)";
-}
 
 TEST_F(Cli, Listing41RendersWithOverrides) {
   writeVdb((dir_ / "cloud.vdb").string(), makeCloud(16, 1));
-  write("scene.json", listing41("cloud.vdb"));
+  write("scene.json", listing41Json("cloud.vdb"));
   const RunResult r = run("render scene.json -o out/listing.exr --resolution 24x12 --spp 2 --stats-json stats.json");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "out/listing.exr"));
@@ -139,7 +64,7 @@ TEST_F(Cli, Listing41RendersWithOverrides) {
   const ImageRGB img = readExr((dir_ / "out/listing.exr").string());
   EXPECT_EQ(img.width, 24);
   EXPECT_EQ(img.height, 12);
-  const nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "stats.json"));
+  const nlohmann::json stats = nlohmann::json::parse(readFile(dir_ / "stats.json"));
   for (const char* key : {"algorithm", "device", "width", "height", "spp", "bounces", "seconds", "kernel_seconds",
                           "samples_per_second", "nan_pixels"})
     EXPECT_TRUE(stats.contains(key)) << key;
@@ -168,13 +93,13 @@ TEST_F(Cli, MalformedJson) {
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_EQ(r.err.rfind("narval: scene.json: ", 0), 0u) << r.err;
-  EXPECT_EQ(slurp(dir_ / "keep.exr"), "precious");
+  EXPECT_EQ(readFile(dir_ / "keep.exr"), "precious");
   EXPECT_EQ(outputs({"scene.json", "keep.exr"}), std::vector<std::string>{});
 }
 
 TEST_F(Cli, WrongType) {
   writeVdb((dir_ / "cloud.vdb").string(), makeCloud(8, 1));
-  std::string s = listing41("cloud.vdb");
+  std::string s = listing41Json("cloud.vdb");
   s.replace(s.find("\"spp\": 1000"), 11, "\"spp\": \"many\"");
   write("scene.json", s);
   expectBadInput(*this, run("render scene.json"), "narval: scene.json: renderer.spp: expected an integer, got string");
@@ -183,7 +108,7 @@ TEST_F(Cli, WrongType) {
 
 TEST_F(Cli, MissingKey) {
   writeVdb((dir_ / "cloud.vdb").string(), makeCloud(8, 1));
-  std::string s = listing41("cloud.vdb");
+  std::string s = listing41Json("cloud.vdb");
   s.replace(s.find("\"lookAt\": [0, 0, 0],"), 20, "");
   write("scene.json", s);
   expectBadInput(*this, run("render scene.json"), "narval: scene.json: camera.lookAt: missing required key");
@@ -191,7 +116,7 @@ TEST_F(Cli, MissingKey) {
 }
 
 TEST_F(Cli, MissingVolumeFile) {
-  write("scene.json", listing41("vdb/wdas_cloud_quarter.vdb"));
+  write("scene.json", listing41Json("vdb/wdas_cloud_quarter.vdb"));
   const RunResult r = run("render scene.json");
   expectBadInput(*this, r,
                  "narval: scene.json: materials[1].path: volume file not found: " +
@@ -206,7 +131,7 @@ TEST_F(Cli, MissingSceneFile) {
 TEST_F(Cli, MissingGridListsTheGridsPresent) {
   DenseGrid g = makeCloud(8, 1);
   writeVdb((dir_ / "smoke.vdb").string(), g, "smoke");
-  write("scene.json", listing41("smoke.vdb"));
+  write("scene.json", listing41Json("smoke.vdb"));
   const RunResult r = run("render scene.json");
   expectBadInput(*this, r,
                  "narval: " + (dir_ / "smoke.vdb").string() + ": grid: no grid named 'density' (the file has: smoke)");
@@ -214,10 +139,9 @@ TEST_F(Cli, MissingGridListsTheGridsPresent) {
 }
 
 TEST_F(Cli, RealFireHasNoDensityGrid) {
-  const char* env = std::getenv("NARVAL_DATA_DIR");
-  const fs::path fire = fs::path(env ? env : NARVAL_DEFAULT_DATA_DIR) / "embergen_fire_a_50.vdb";
-  if (!fs::exists(fire)) GTEST_SKIP() << "real data absent: " << fire << " (set NARVAL_DATA_DIR)";
-  write("scene.json", listing41(fire.string()));
+  const std::string fire = realDataPath("embergen_fire_a_50.vdb");
+  NARVAL_REQUIRE_REAL_DATA(fire);
+  write("scene.json", listing41Json(fire));
   const RunResult r = run("render scene.json");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no grid named 'density' (the file has: flames, temperature)"), std::string::npos) << r.err;
@@ -225,7 +149,7 @@ TEST_F(Cli, RealFireHasNoDensityGrid) {
 
 TEST_F(Cli, UnavailableAlgorithmAndBadOptions) {
   writeVdb((dir_ / "cloud.vdb").string(), makeCloud(8, 1));
-  write("scene.json", listing41("cloud.vdb"));
+  write("scene.json", listing41Json("cloud.vdb"));
   expectBadInput(*this, run("render scene.json --algorithm raymarch"),
                  "narval: scene.json: renderer.algorithm: 'raymarch' is not available yet (available: pathtrace)");
   expectBadInput(*this, run("render scene.json --resolution 10by3"),
@@ -268,10 +192,9 @@ namespace {
 // The dragon's file transform rotates and shears: in the default "unit" grid space that part is
 // dropped, and the user is told so (DESIGN.md, physics conventions); "file" keeps it, silently.
 TEST_F(Cli, DragonTransformWarningInUnitGridSpaceOnly) {
-  const char* env = std::getenv("NARVAL_DATA_DIR");
-  const fs::path dragon = fs::path(env ? env : NARVAL_DEFAULT_DATA_DIR) / "vpt_dragon_with_xform.vdb";
-  if (!fs::exists(dragon)) GTEST_SKIP() << "real data absent: " << dragon << " (set NARVAL_DATA_DIR)";
-  write("scene.json", listing41(dragon.string()));
+  const std::string dragon = realDataPath("vpt_dragon_with_xform.vdb");
+  NARVAL_REQUIRE_REAL_DATA(dragon);
+  write("scene.json", listing41Json(dragon));
   RunResult r = run("render scene.json --resolution 8x4 --spp 1");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err,

@@ -6,7 +6,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <optional>
 #include <set>
 #include <string>
@@ -17,6 +16,7 @@
 
 #include "cl/cl_runtime.h"
 #include "scene/input_error.h"
+#include "test_support.h"
 
 namespace narval {
 const std::map<std::string, std::string>& testKernelSources();
@@ -24,6 +24,9 @@ const std::map<std::string, std::string>& testKernelSources();
 
 namespace fs = std::filesystem;
 using namespace narval;
+using narval::test::readFile;
+using narval::test::ScopedEnv;
+using narval::test::TempDir;
 
 namespace {
 
@@ -32,51 +35,6 @@ namespace {
     if (listDevices().empty())                                                          \
       GTEST_SKIP() << "no OpenCL platform or device on this machine (install pocl-opencl-icd)"; \
   } while (0)
-
-// Sets (or unsets, with nullopt) an environment variable for one scope.
-class EnvGuard {
- public:
-  EnvGuard(const char* name, const std::optional<std::string>& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    if (value)
-      setenv(name, value->c_str(), 1);
-    else
-      unsetenv(name);
-  }
-  ~EnvGuard() {
-    if (old_)
-      setenv(name_.c_str(), old_->c_str(), 1);
-    else
-      unsetenv(name_.c_str());
-  }
-
- private:
-  std::string name_;
-  std::optional<std::string> old_;
-};
-
-// A fresh empty folder, removed at the end of the scope.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::path(testing::TempDir()) / "narval-cache-XXXXXX").string();
-    path_ = mkdtemp(&pattern[0]) ? fs::path(pattern) : fs::path();
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  std::vector<fs::path> files() const {
-    std::vector<fs::path> out;
-    for (const auto& e : fs::directory_iterator(path_)) out.push_back(e.path());
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-
- private:
-  fs::path path_;
-};
 
 // Runs cache_probe over n items and returns what it wrote.
 std::vector<cl_uint> runProbe(ClRuntime& rt, cl::Program& program, cl_uint n) {
@@ -95,9 +53,19 @@ void expectProbe(ClRuntime& rt, cl::Program& program, cl_uint factor) {
   for (cl_uint i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], i * factor) << "item " << i;
 }
 
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+// Builds cache_probe.cl with `options` and says whether the program came from the cache.
+bool buildProbeHitsCache(ClRuntime& rt, const std::string& options = "") {
+  bool hit = false;
+  buildProgram(rt, "cache_probe.cl", options, &testKernelSources(), &hit);
+  return hit;
+}
+
+// The same, then runs the program and checks what it writes (item i holds i * factor).
+bool runProbeHitsCache(ClRuntime& rt, const std::string& options, cl_uint factor) {
+  bool hit = false;
+  cl::Program program = buildProgram(rt, "cache_probe.cl", options, &testKernelSources(), &hit);
+  expectProbe(rt, program, factor);
+  return hit;
 }
 
 }  // namespace
@@ -290,7 +258,7 @@ TEST(ClRuntime, NamesErrorCodes) {
 
 TEST(ProgramCache, BuildErrorNamesTheRealFileAndLine) {
   SKIP_WITHOUT_DEVICES();
-  EnvGuard cache("NARVAL_CACHE_DIR", std::string("off"));
+  ScopedEnv cache("NARVAL_CACHE_DIR", std::string("off"));
   // The line of the deliberate error, read from the file itself so the test follows edits.
   std::ifstream in(std::string(NARVAL_SOURCE_DIR) + "/tests/device/build_error_test.cl");
   ASSERT_TRUE(in) << "cannot read build_error_test.cl";
@@ -322,62 +290,46 @@ TEST(ProgramCache, UnknownKernelFileIsARuntimeError) {
 
 TEST(ProgramCache, SecondBuildComesFromTheCacheAndRuns) {
   SKIP_WITHOUT_DEVICES();
-  TempDir dir;
+  TempDir dir("narval-cache");
   ASSERT_FALSE(dir.path().empty());
-  EnvGuard cache("NARVAL_CACHE_DIR", dir.path().string());
+  ScopedEnv cache("NARVAL_CACHE_DIR", dir.path().string());
   ClRuntime rt("");
-  bool hit = true;
-  cl::Program first = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-  EXPECT_FALSE(hit);
-  ASSERT_EQ(dir.files().size(), 1u);
-  EXPECT_EQ(dir.files()[0].extension(), ".bin");
-  expectProbe(rt, first, 2);
+  EXPECT_FALSE(runProbeHitsCache(rt, "", 2));
+  ASSERT_EQ(dir.entries().size(), 1u);
+  EXPECT_EQ(fs::path(dir.entries()[0]).extension(), ".bin");
 
-  cl::Program second = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-  EXPECT_TRUE(hit);
-  EXPECT_EQ(dir.files().size(), 1u);
-  expectProbe(rt, second, 2);
+  EXPECT_TRUE(runProbeHitsCache(rt, "", 2));
+  EXPECT_EQ(dir.entries().size(), 1u);
 
   // A fresh runtime (as a second narval process would have) also hits.
   ClRuntime other("");
-  cl::Program third = buildProgram(other, "cache_probe.cl", "", &testKernelSources(), &hit);
-  EXPECT_TRUE(hit);
-  expectProbe(other, third, 2);
+  EXPECT_TRUE(runProbeHitsCache(other, "", 2));
 }
 
 TEST(ProgramCache, OptionsChangeTheKey) {
   SKIP_WITHOUT_DEVICES();
-  TempDir dir;
-  EnvGuard cache("NARVAL_CACHE_DIR", dir.path().string());
+  TempDir dir("narval-cache");
+  ScopedEnv cache("NARVAL_CACHE_DIR", dir.path().string());
   ClRuntime rt("");
-  bool hit = true;
-  buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-  EXPECT_FALSE(hit);
-  cl::Program three = buildProgram(rt, "cache_probe.cl", "-DPROBE_FACTOR=3", &testKernelSources(), &hit);
-  EXPECT_FALSE(hit);
-  EXPECT_EQ(dir.files().size(), 2u);
-  expectProbe(rt, three, 3);
-  cl::Program cached = buildProgram(rt, "cache_probe.cl", "-DPROBE_FACTOR=3", &testKernelSources(), &hit);
-  EXPECT_TRUE(hit);
-  expectProbe(rt, cached, 3);
+  EXPECT_FALSE(buildProbeHitsCache(rt));
+  EXPECT_FALSE(runProbeHitsCache(rt, "-DPROBE_FACTOR=3", 3));
+  EXPECT_EQ(dir.entries().size(), 2u);
+  EXPECT_TRUE(runProbeHitsCache(rt, "-DPROBE_FACTOR=3", 3));
 }
 
 TEST(ProgramCache, CorruptEntriesFallBackToTheSourceAndAreRewritten) {
   SKIP_WITHOUT_DEVICES();
-  TempDir dir;
-  EnvGuard cache("NARVAL_CACHE_DIR", dir.path().string());
+  TempDir dir("narval-cache");
+  ScopedEnv cache("NARVAL_CACHE_DIR", dir.path().string());
   ClRuntime rt("");
-  bool hit = true;
-  buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-  ASSERT_EQ(dir.files().size(), 1u);
-  const fs::path entry = dir.files()[0];
+  buildProbeHitsCache(rt);
+  ASSERT_EQ(dir.entries().size(), 1u);
+  const fs::path entry = dir.path() / dir.entries()[0];
   const std::string good = readFile(entry);
 
   // Truncated: the header's size no longer matches.
   std::ofstream(entry, std::ios::binary | std::ios::trunc) << good.substr(0, good.size() / 2);
-  cl::Program a = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-  EXPECT_FALSE(hit);
-  expectProbe(rt, a, 2);
+  EXPECT_FALSE(runProbeHitsCache(rt, "", 2));
   EXPECT_EQ(readFile(entry), good) << "the entry is rewritten";
 
   // A well-formed entry whose payload the driver must refuse.
@@ -386,47 +338,39 @@ TEST(ProgramCache, CorruptEntriesFallBackToTheSourceAndAreRewritten) {
   for (std::uint64_t v : {std::uint64_t(payload.size()), fnv1a64(payload)})
     for (int i = 0; i < 8; ++i) forged.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
   std::ofstream(entry, std::ios::binary | std::ios::trunc) << forged + payload;
-  cl::Program b = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-  EXPECT_FALSE(hit);
-  expectProbe(rt, b, 2);
-  buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-  EXPECT_TRUE(hit);
+  EXPECT_FALSE(runProbeHitsCache(rt, "", 2));
+  EXPECT_TRUE(buildProbeHitsCache(rt));
 }
 
 TEST(ProgramCache, OffAndUnwritableFoldersNeverFail) {
   SKIP_WITHOUT_DEVICES();
   ClRuntime rt("");
-  bool hit = true;
   {
-    EnvGuard cache("NARVAL_CACHE_DIR", std::string("off"));
+    ScopedEnv cache("NARVAL_CACHE_DIR", std::string("off"));
     EXPECT_EQ(programCacheDir(), "");
-    cl::Program p = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-    EXPECT_FALSE(hit);
-    expectProbe(rt, p, 2);
+    EXPECT_FALSE(runProbeHitsCache(rt, "", 2));
   }
   {
     // A folder under a regular file can never be created.
-    TempDir dir;
+    TempDir dir("narval-cache");
     const fs::path file = dir.path() / "a-file";
     std::ofstream(file) << "x";
-    EnvGuard cache("NARVAL_CACHE_DIR", (file / "cache").string());
-    cl::Program p = buildProgram(rt, "cache_probe.cl", "", &testKernelSources(), &hit);
-    EXPECT_FALSE(hit);
-    expectProbe(rt, p, 2);
+    ScopedEnv cache("NARVAL_CACHE_DIR", (file / "cache").string());
+    EXPECT_FALSE(runProbeHitsCache(rt, "", 2));
   }
 }
 
 TEST(ProgramCache, FolderFollowsTheEnvironment) {
-  EnvGuard narval("NARVAL_CACHE_DIR", std::nullopt);
+  ScopedEnv narval("NARVAL_CACHE_DIR", std::nullopt);
   {
-    EnvGuard xdg("XDG_CACHE_HOME", std::string("/tmp/xdg"));
+    ScopedEnv xdg("XDG_CACHE_HOME", std::string("/tmp/xdg"));
     EXPECT_EQ(programCacheDir(), "/tmp/xdg/narval");
   }
   {
-    EnvGuard xdg("XDG_CACHE_HOME", std::nullopt);
-    EnvGuard home("HOME", std::string("/home/someone"));
+    ScopedEnv xdg("XDG_CACHE_HOME", std::nullopt);
+    ScopedEnv home("HOME", std::string("/home/someone"));
     EXPECT_EQ(programCacheDir(), "/home/someone/.cache/narval");
   }
-  EnvGuard set("NARVAL_CACHE_DIR", std::string("/var/tmp/nc"));
+  ScopedEnv set("NARVAL_CACHE_DIR", std::string("/var/tmp/nc"));
   EXPECT_EQ(programCacheDir(), "/var/tmp/nc");
 }

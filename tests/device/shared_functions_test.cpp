@@ -94,6 +94,9 @@ class FloatDiff {
 
 // ---- running kernels ----
 
+// Where a value came from, for failure messages.
+std::string at(size_t i) { return "item " + std::to_string(i); }
+
 class SharedOnDevice : public testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -142,13 +145,23 @@ class SharedOnDevice : public testing::Test {
     return result;
   }
 
+  // Runs `kernel`, a function f(g, x) with one float output per item, at every (g[i], x[i]) and
+  // compares what it writes with the host's host(g[i], x[i]) (scale as in FloatDiff::add).
+  template <typename HostFn>
+  static void compareGx(const char* kernel, const std::string& name, HostFn host, const std::vector<float>& g,
+                        const std::vector<float>& x, float scale) {
+    const size_t n = g.size();
+    const std::vector<float> dev = run<float>(kernel, n, n, 2, input(g), input(x));
+    FloatDiff diff(name);
+    for (size_t i = 0; i < n; ++i) diff.add(host(g[i], x[i]), dev[i], scale, at(i));
+    diff.report();
+  }
+
   static narval::ClRuntime* rt_;
   static cl::Program* program_;
 };
 narval::ClRuntime* SharedOnDevice::rt_ = nullptr;
 cl::Program* SharedOnDevice::program_ = nullptr;
-
-std::string at(size_t i) { return "item " + std::to_string(i); }
 
 const std::vector<float>& testGs() {
   static const std::vector<float> gs = {-0.999999f, -0.99f, -0.9f, -0.5f, -1e-5f, 0.0f,
@@ -165,11 +178,7 @@ TEST_F(SharedOnDevice, PhaseHgEval) {
       g.push_back(gv);
       mu.push_back(k == 400 ? 1.0f : -1.0f + k / 200.0f);
     }
-  const size_t n = g.size();
-  const std::vector<float> dev = run<float>("sf_phase_hg_eval", n, n, 2, input(g), input(mu));
-  FloatDiff diff("phase_hg_eval");
-  for (size_t i = 0; i < n; ++i) diff.add(phase_hg_eval(g[i], mu[i]), dev[i], 0.0f, at(i));
-  diff.report();
+  compareGx("sf_phase_hg_eval", "phase_hg_eval", phase_hg_eval, g, mu, 0.0f);
 }
 
 TEST_F(SharedOnDevice, PhaseHgSampleCos) {
@@ -181,11 +190,7 @@ TEST_F(SharedOnDevice, PhaseHgSampleCos) {
       g.push_back(gv);
       u.push_back(k == 0 ? 0.0f : (k == 1 ? 0.99999994f : uni(gen)));
     }
-  const size_t n = g.size();
-  const std::vector<float> dev = run<float>("sf_phase_hg_sample_cos", n, n, 2, input(g), input(u));
-  FloatDiff diff("phase_hg_sample_cos");
-  for (size_t i = 0; i < n; ++i) diff.add(phase_hg_sample_cos(g[i], u[i]), dev[i], 1.0f, at(i));
-  diff.report();
+  compareGx("sf_phase_hg_sample_cos", "phase_hg_sample_cos", phase_hg_sample_cos, g, u, 1.0f);
 }
 
 TEST_F(SharedOnDevice, PhaseSample) {

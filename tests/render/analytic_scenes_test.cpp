@@ -3,11 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
 
 #include "render/scene_upload.h"
 #include "render_fixture.h"
+#include "test_support.h"
 #include "volume/grid.h"
 
 namespace narval::test {
@@ -97,9 +96,8 @@ TEST(RenderAnalytic, WhiteFurnaceOnGeneratedCloudIsExactlyOne) {
 }
 
 TEST(RenderAnalytic, WhiteFurnaceOnDisneyCloudIsExactlyOne) {
-  const char* env = std::getenv("NARVAL_DATA_DIR");
-  const std::string path = std::string(env ? env : NARVAL_DEFAULT_DATA_DIR) + "/wdas_cloud_sixteenth.vdb";
-  if (!std::ifstream(path)) GTEST_SKIP() << "real data absent: " << path << " (set NARVAL_DATA_DIR)";
+  const std::string path = realDataPath("wdas_cloud_sixteenth.vdb");
+  NARVAL_REQUIRE_REAL_DATA(path);
   const DenseGrid cloud = loadGrid(path, "density");
   const RenderResult r = render(sceneFromJson(furnaceScene("", "[1, 1, 1]")), &cloud);
   expectAllExactlyOne(r.image);

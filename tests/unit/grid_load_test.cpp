@@ -2,8 +2,6 @@
 // (../shared/data/volumes or NARVAL_DATA_DIR; skipped, saying why, when absent), .vdb write/read
 // round trips and error paths, the text .vol format and its errors, and the procedural cloud.
 #include <gtest/gtest.h>
-#include <stdlib.h>
-#include <unistd.h>
 
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
@@ -15,7 +13,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -23,44 +20,21 @@
 #include <vector>
 
 #include "scene/input_error.h"
+#include "test_support.h"
 #include "volume/grid.h"
 
 namespace fs = std::filesystem;
 using narval::DenseGrid;
 using narval::InputError;
+using narval::test::readFile;
+using narval::test::realDataPath;
+using narval::test::TempDir;
+using narval::test::writeFile;
 
 namespace {
 
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "narval_grid_test_XXXXXX").string();
-    if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  std::vector<std::string> entries() const {
-    std::vector<std::string> out;
-    for (const auto& e : fs::directory_iterator(path_)) out.push_back(e.path().filename().string());
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-
- private:
-  fs::path path_;
-};
-
-void writeText(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-}
 
 // The message of the InputError `fn` throws ("" and a test failure if it throws nothing).
 template <typename Fn>
@@ -79,28 +53,9 @@ std::string errorOf(Fn&& fn) {
 
 // ---- real data ----
 
-std::string dataDir() {
-  if (const char* env = std::getenv("NARVAL_DATA_DIR"); env && *env) return env;
-  return NARVAL_DEFAULT_DATA_DIR;
-}
-
-// The path of a real data file, or "" (and the reason in `why`) when it is absent.
-std::string dataFile(const std::string& name, std::string& why) {
-  const fs::path p = fs::path(dataDir()) / name;
-  if (!fs::is_regular_file(p)) {
-    why = "real data file " + p.string() + " is absent (set NARVAL_DATA_DIR to the folder of shared/data/volumes)";
-    return "";
-  }
-  return p.string();
-}
-
-#define REQUIRE_DATA(var, name)            \
-  std::string var##_why;                   \
-  const std::string var = dataFile(name, var##_why); \
-  if (var.empty()) GTEST_SKIP() << var##_why
-
 TEST(VdbRealData, DisneyCloudLoadsWithItsDocumentedExtent) {
-  REQUIRE_DATA(path, "wdas_cloud_sixteenth.vdb");
+  const std::string path = realDataPath("wdas_cloud_sixteenth.vdb");
+  NARVAL_REQUIRE_REAL_DATA(path);
   const DenseGrid g = narval::loadVdb(path, "density");
   EXPECT_EQ(g.nx, 126);
   EXPECT_EQ(g.ny, 86);
@@ -126,8 +81,10 @@ TEST(VdbRealData, DisneyCloudLoadsWithItsDocumentedExtent) {
 }
 
 TEST(VdbRealData, SmokeEncodingsHoldTheSameGrid) {
-  REQUIRE_DATA(v222, "openvdb_smoke1_v222.vdb");
-  REQUIRE_DATA(v223, "openvdb_smoke1_v223_blosc.vdb");
+  const std::string v222 = realDataPath("openvdb_smoke1_v222.vdb");
+  NARVAL_REQUIRE_REAL_DATA(v222);
+  const std::string v223 = realDataPath("openvdb_smoke1_v223_blosc.vdb");
+  NARVAL_REQUIRE_REAL_DATA(v223);
   const DenseGrid a = narval::loadVdb(v222, "density");
   const DenseGrid b = narval::loadVdb(v223, "density");
   EXPECT_EQ(a.nx, 111);
@@ -145,7 +102,8 @@ TEST(VdbRealData, SmokeEncodingsHoldTheSameGrid) {
 }
 
 TEST(VdbRealData, FireWithoutDensityNamesTheGridsItHas) {
-  REQUIRE_DATA(path, "embergen_fire_a_50.vdb");
+  const std::string path = realDataPath("embergen_fire_a_50.vdb");
+  NARVAL_REQUIRE_REAL_DATA(path);
   EXPECT_EQ(errorOf([&] { narval::loadVdb(path, "density"); }),
             path + ": grid: no grid named 'density' (the file has: flames, temperature)");
   EXPECT_EQ(errorOf([&] { narval::loadGrid(path); }),
@@ -163,7 +121,8 @@ TEST(VdbRealData, FireWithoutDensityNamesTheGridsItHas) {
 }
 
 TEST(VdbRealData, DragonKeepsItsAffineTransform) {
-  REQUIRE_DATA(path, "vpt_dragon_with_xform.vdb");
+  const std::string path = realDataPath("vpt_dragon_with_xform.vdb");
+  NARVAL_REQUIRE_REAL_DATA(path);
   const DenseGrid g = narval::loadVdb(path, "density");
   EXPECT_EQ(g.nx, 141);
   EXPECT_EQ(g.ny, 99);
@@ -180,20 +139,20 @@ TEST(VdbRealData, DragonKeepsItsAffineTransform) {
 // Truncated and corrupted copies of a real file fail with an InputError naming the file: never
 // a crash, never a silently partial grid.
 TEST(VdbRealData, TruncatedOrCorruptFilesAreCleanErrors) {
-  REQUIRE_DATA(path, "wdas_cloud_sixteenth.vdb");
-  std::ifstream in(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string path = realDataPath("wdas_cloud_sixteenth.vdb");
+  NARVAL_REQUIRE_REAL_DATA(path);
+  const std::string bytes = readFile(path);
   TempDir dir;
   const std::string cut = dir.file("cut.vdb");
   for (double fraction : {0.0, 0.001, 0.01, 0.1, 0.3, 0.5, 0.9, 0.999}) {
-    writeText(cut, bytes.substr(0, size_t(double(bytes.size()) * fraction)));
+    writeFile(cut, bytes.substr(0, size_t(double(bytes.size()) * fraction)));
     const std::string msg = errorOf([&] { narval::loadVdb(cut, "density"); });
     EXPECT_EQ(msg.rfind(cut + ": ", 0), 0u) << "fraction " << fraction << ": " << msg;
   }
   // Garbage after a valid header region.
   std::string corrupt = bytes;
   for (size_t i = 4096; i < corrupt.size(); i += 7) corrupt[i] = char(corrupt[i] ^ 0x5a);
-  writeText(cut, corrupt);
+  writeFile(cut, corrupt);
   const std::string msg = errorOf([&] { narval::loadVdb(cut, "density"); });
   EXPECT_EQ(msg.rfind(cut + ": ", 0), 0u) << msg;
 }
@@ -203,9 +162,9 @@ TEST(VdbRealData, TruncatedOrCorruptFilesAreCleanErrors) {
 // that this process survives and reports the file. Each corrupted copy either loads (the flips hit
 // nothing that matters) or fails with an InputError naming the file, and nothing crashes later.
 TEST(VdbRealData, CorruptedCompressedFilesNeverCrashTheProcess) {
-  REQUIRE_DATA(path, "vpt_dragon_with_xform.vdb");
-  std::ifstream in(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string path = realDataPath("vpt_dragon_with_xform.vdb");
+  NARVAL_REQUIRE_REAL_DATA(path);
+  const std::string bytes = readFile(path);
   TempDir dir;
   const std::string bad = dir.file("bad.vdb");
   int failed = 0;
@@ -217,7 +176,7 @@ TEST(VdbRealData, CorruptedCompressedFilesNeverCrashTheProcess) {
       const size_t pos = h % b.size();
       b[pos] = char(b[pos] ^ char(1 + (h >> 24) % 255));
     }
-    writeText(bad, b);
+    writeFile(bad, b);
     try {
       narval::loadVdb(bad, "density");
     } catch (const InputError& e) {
@@ -321,11 +280,11 @@ TEST(VdbErrors, MissingAndNonVdbFiles) {
   EXPECT_EQ(errorOf([&] { narval::loadVdb(dir.file(""), "density"); }).find("it is a directory") != std::string::npos,
             true);
   const std::string text = dir.file("text.vdb");
-  writeText(text, "this is not a vdb file at all, just some text\n");
+  writeFile(text, "this is not a vdb file at all, just some text\n");
   const std::string msg = errorOf([&] { narval::loadVdb(text, "density"); });
   EXPECT_EQ(msg.rfind(text + ": not a readable OpenVDB file (", 0), 0u) << msg;
   const std::string empty = dir.file("empty.vdb");
-  writeText(empty, "");
+  writeFile(empty, "");
   const std::string msg2 = errorOf([&] { narval::loadVdb(empty, "density"); });
   EXPECT_EQ(msg2.rfind(empty + ": not a readable OpenVDB file (", 0), 0u) << msg2;
 }
@@ -417,7 +376,7 @@ TEST(VolFormat, RoundTripIsBitExactWithAnyLineBreaks) {
   for (int i = 0; i < 60; ++i) src.data.push_back(i == 7 ? 0.0f : std::ldexp(float(i * 37 % 61) / 7.0f, i % 9 - 4));
   const std::string path = dir.file("grid.vol");
   for (int perLine : {1, 5, 7, 60}) {
-    writeText(path, volText(src, perLine));
+    writeFile(path, volText(src, perLine));
     const DenseGrid g = narval::loadVol(path);
     ASSERT_EQ(g.nx, 5);
     ASSERT_EQ(g.ny, 3);
@@ -429,19 +388,19 @@ TEST(VolFormat, RoundTripIsBitExactWithAnyLineBreaks) {
     EXPECT_EQ(g.source, path);
   }
   // x fastest: the value at (x, y, z) is number x + nx * (y + ny * z) in the file.
-  writeText(path, "2 2 2\n0 1 2 3 4 5 6 7");
+  writeFile(path, "2 2 2\n0 1 2 3 4 5 6 7");
   const DenseGrid g = narval::loadVol(path);
   EXPECT_EQ(g.at(1, 0, 0), 1.0f);
   EXPECT_EQ(g.at(0, 1, 0), 2.0f);
   EXPECT_EQ(g.at(0, 0, 1), 4.0f);
   EXPECT_EQ(g.at(1, 1, 1), 7.0f);
   // Windows line endings, tabs, a byte order mark, '+' signs and exponents are fine.
-  writeText(path, "\xEF\xBB\xBF" "2 1 1\r\n+1.5e0\t\r\n 2E-1 \r\n");
+  writeFile(path, "\xEF\xBB\xBF" "2 1 1\r\n+1.5e0\t\r\n 2E-1 \r\n");
   const DenseGrid w = narval::loadGrid(path);
   EXPECT_EQ(w.data, (std::vector<float>{1.5f, 0.2f}));
   // Upper-case extension dispatches too.
   const std::string upper = dir.file("GRID.VOL");
-  writeText(upper, "1 1 1\n0.5\n");
+  writeFile(upper, "1 1 1\n0.5\n");
   EXPECT_EQ(narval::loadGrid(upper).data, std::vector<float>{0.5f});
 }
 
@@ -449,7 +408,7 @@ TEST(VolFormat, HeaderErrors) {
   TempDir dir;
   const std::string p = dir.file("bad.vol");
   auto err = [&](const std::string& text) {
-    writeText(p, text);
+    writeFile(p, text);
     return errorOf([&] { narval::loadVol(p); });
   };
   const std::string hdr = p + ": line 1: expected the header 'X Y Z' (three positive integers), found ";
@@ -468,7 +427,7 @@ TEST(VolFormat, AbsurdSizesFailBeforeAllocating) {
   TempDir dir;
   const std::string p = dir.file("big.vol");
   auto err = [&](const std::string& text) {
-    writeText(p, text);
+    writeFile(p, text);
     return errorOf([&] { narval::loadVol(p); });
   };
   EXPECT_EQ(err("100000 100000 100000\n1 2 3\n"),
@@ -488,7 +447,7 @@ TEST(VolFormat, ValueErrors) {
   TempDir dir;
   const std::string p = dir.file("v.vol");
   auto err = [&](const std::string& text) {
-    writeText(p, text);
+    writeFile(p, text);
     return errorOf([&] { narval::loadVol(p); });
   };
   auto values = [](int n, const std::string& sep = " ") {
@@ -512,7 +471,7 @@ TEST(VolFormat, ValueErrors) {
             p + ": 4 non-finite and 2 negative values (first at voxel 1 0 0); densities must be finite and >= 0");
   EXPECT_EQ(err("2 1 1\n1 NaN\n"), p + ": 1 non-finite value (first at voxel 1 0 0); densities must be finite and >= 0");
   // Underflow is 0, negative zero is fine.
-  writeText(p, "3 1 1\n1e-60 -0 0.5\n");
+  writeFile(p, "3 1 1\n1e-60 -0 0.5\n");
   const DenseGrid g = narval::loadVol(p);
   EXPECT_EQ(g.data[0], 0.0f);
   EXPECT_EQ(g.maxValue, 0.5f);
@@ -521,11 +480,11 @@ TEST(VolFormat, ValueErrors) {
 TEST(GridLoad, DispatchOnExtension) {
   TempDir dir;
   const std::string raw = dir.file("cloud.raw");
-  writeText(raw, "1 1 1\n1\n");
+  writeFile(raw, "1 1 1\n1\n");
   EXPECT_EQ(errorOf([&] { narval::loadGrid(raw); }),
             raw + ": unknown volume file type '.raw' (narval reads .vdb and .vol)");
   const std::string none = dir.file("cloud");
-  writeText(none, "1 1 1\n1\n");
+  writeFile(none, "1 1 1\n1\n");
   EXPECT_EQ(errorOf([&] { narval::loadGrid(none); }),
             none + ": unknown volume file type '(none)' (narval reads .vdb and .vol)");
   const std::string missing = dir.file("missing.vol");

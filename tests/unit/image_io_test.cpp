@@ -9,7 +9,6 @@
 #include <gtest/gtest.h>
 #include <png.h>
 #include <signal.h>
-#include <stdlib.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -19,8 +18,6 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <map>
 #include <random>
@@ -31,52 +28,19 @@
 #include "image/image.h"
 #include "scene/input_error.h"
 #include "shared/tonemap.h"
+#include "test_support.h"
 
 namespace fs = std::filesystem;
 using narval::ImageRGB;
 using narval::ToneMapping;
+using narval::test::readFile;
+using narval::test::TempDir;
+using narval::test::writeFile;
 
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-// A fresh directory per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "narval_image_test_XXXXXX").string();
-    if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::permissions(path_, fs::perms::owner_all, fs::perm_options::add, ec);
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  const fs::path& path() const { return path_; }
-  // Names in the directory, to check that no temporary file is left behind.
-  std::vector<std::string> entries() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(path_)) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
- private:
-  fs::path path_;
-};
-
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void writeBytes(const std::string& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out << bytes;
-}
 
 uint32_t bits(float f) {
   uint32_t u;
@@ -408,9 +372,9 @@ TEST(ExrTest, MissingFileIsAnInputError) {
 TEST(ExrTest, GarbageFileIsAnInputError) {
   TempDir dir;
   const std::string path = dir.file("garbage.exr");
-  writeBytes(path, "this is not an image\n");
+  writeFile(path, "this is not an image\n");
   EXPECT_EQ(inputErrorOf([&] { narval::readExr(path); }), path + ": not an OpenEXR file");
-  writeBytes(path, "");
+  writeFile(path, "");
   EXPECT_EQ(inputErrorOf([&] { narval::readExr(path); }), path + ": not an OpenEXR file");
 }
 
@@ -418,10 +382,10 @@ TEST(ExrTest, TruncatedFileIsAnInputError) {
   TempDir dir;
   const std::string good = dir.file("good.exr");
   narval::writeExr(good, noiseImage(64, 64, 2));
-  const std::string bytes = readBytes(good);
+  const std::string bytes = readFile(good);
   for (size_t keep : {size_t(8), size_t(200), bytes.size() / 2, bytes.size() - 1}) {
     const std::string path = dir.file("cut.exr");
-    writeBytes(path, bytes.substr(0, keep));
+    writeFile(path, bytes.substr(0, keep));
     const std::string message = inputErrorOf([&] { narval::readExr(path); });
     EXPECT_EQ(message.rfind(path + ": corrupt OpenEXR file: ", 0), 0u) << "kept " << keep << ": " << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
@@ -436,9 +400,9 @@ TEST(ExrTest, FailedWriteLeavesExistingFileUntouched) {
   const std::string path = dir.file("keep.exr");
   const ImageRGB big = noiseImage(64, 64, 3);
   narval::writeExr(path, big);
-  const size_t fullSize = readBytes(path).size();
+  const size_t fullSize = readFile(path).size();
   narval::writeExr(path, makeImage(1, 1, {0.25f, 0.5f, 0.75f}), {{"old", "yes"}});
-  const std::string before = readBytes(path);
+  const std::string before = readFile(path);
   for (size_t limit : {size_t(100), size_t(4096), fullSize / 2, fullSize - 1}) {
     std::string message;
     {
@@ -448,7 +412,7 @@ TEST(ExrTest, FailedWriteLeavesExistingFileUntouched) {
     }
     EXPECT_EQ(message.rfind(path + ": cannot write: ", 0), 0u) << "limit " << limit << ": " << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-    EXPECT_EQ(readBytes(path), before) << "limit " << limit;
+    EXPECT_EQ(readFile(path), before) << "limit " << limit;
     EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.exr"}) << "limit " << limit;
   }
   EXPECT_EQ(narval::readExrAttributes(path).at("old"), "yes");
@@ -459,12 +423,12 @@ TEST(ExrTest, UnwritableDirectoryLeavesExistingFileUntouched) {
   TempDir dir;
   const std::string path = dir.file("keep.exr");
   narval::writeExr(path, makeImage(1, 1, {1, 2, 3}));
-  const std::string before = readBytes(path);
+  const std::string before = readFile(path);
   fs::permissions(dir.path(), fs::perms::owner_read | fs::perms::owner_exec);
   EXPECT_EQ(runtimeErrorOf([&] { narval::writeExr(path, makeImage(2, 2, {})); }),
             path + ": cannot write: Permission denied");
   fs::permissions(dir.path(), fs::perms::owner_all);
-  EXPECT_EQ(readBytes(path), before);
+  EXPECT_EQ(readFile(path), before);
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.exr"});
 }
 
@@ -534,7 +498,7 @@ TEST(PngTest, LayoutChannelsAndRows) {
   EXPECT_EQ(h, 2);
   EXPECT_EQ(px, (std::vector<uint8_t>{255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255}));
   // 8-bit RGB, marked sRGB (an sRGB chunk).
-  const std::string bytes = readBytes(path);
+  const std::string bytes = readFile(path);
   EXPECT_EQ(bytes.substr(1, 3), "PNG");
   EXPECT_NE(bytes.find("sRGB"), std::string::npos);
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"layout.png"});
@@ -545,10 +509,10 @@ TEST(PngTest, FailedWriteLeavesExistingFileUntouched) {
   const std::string path = dir.file("keep.png");
   const ImageRGB big = noiseImage(64, 64, 4);  // values in [0, 1000): exposure -10 spreads them
   narval::writePng(path, big, -10.0f, ToneMapping::None);
-  const size_t fullSize = readBytes(path).size();
+  const size_t fullSize = readFile(path).size();
   ASSERT_GT(fullSize, 10000u);  // noise does not compress
   narval::writePng(path, makeImage(1, 1, {0.5f, 0.5f, 0.5f}), 0.0f, ToneMapping::None);
-  const std::string before = readBytes(path);
+  const std::string before = readFile(path);
   for (size_t limit : {size_t(10), size_t(1000), fullSize / 2, fullSize - 1}) {
     std::string message;
     {
@@ -558,7 +522,7 @@ TEST(PngTest, FailedWriteLeavesExistingFileUntouched) {
     }
     EXPECT_EQ(message.rfind(path + ": cannot write: ", 0), 0u) << "limit " << limit << ": " << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-    EXPECT_EQ(readBytes(path), before);
+    EXPECT_EQ(readFile(path), before);
     EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.png"});
   }
   const std::string nowhere = dir.file("missing/out.png");

@@ -2,18 +2,15 @@
 // (exactly, since users and scripts read them), warnings, --set overrides and path resolution.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <sstream>
-
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
 #include "scene/input_error.h"
 #include "scene/scene.h"
+#include "test_support.h"
 
 namespace narval {
 namespace {
@@ -21,64 +18,9 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-// Dissertation Listing 4.1, character for character.
-const char* kListing41 = R"({
-  "materials": [
-    {
-      "name": "emitter",
-      "type": "emitter",
-      "albedo": [20, 20, 20]
-    },
-    {
-      "name": "cloudVolMat",
-      "type": "volume",
-      "scattering": [1.1, 1.1, 1.1],
-      "absorption": [0.01, 0.01, 0.01],
-      "phaseFunction": "hg",
-      "g": 0.9,
-      "path": "vdb/wdas_cloud_quarter.vdb",
-      "density": 10
-    }
-  ],
-  "primitives": [
-    {
-      "name": "rectLight",
-      "type": "rectangle",
-      "transform": {
-        "position": [0, 0, 80],
-        "scale": [150, 100, 1],
-        "rotation": [0, 0, 0]
-      },
-      "materialName": "emitter"
-    },
-    {
-      "name": "cloud",
-      "type": "volume",
-      "transform": {
-        "position": [0.0, 0, 0],
-        "scale": [15.9, 9.51, 13.5],
-        "rotation": [0, 0, 0]
-      },
-      "materialName": "cloudVolMat"
-    }
-  ],
-  "camera": {
-    "position": [0, 0, -17],
-    "lookAt": [0, 0, 0],
-    "up": [0, 1, 0],
-    "speed": 5,
-    "vfov": 45,
-    "aperture": 0.0001,
-    "focus": 1
-  },
-"renderer": {  
-  "resolution": [1200, 600],  
-  "spp": 1000,  
-  "bounces": 3,  
-  "HDR": true,  
-  "toneMapping": true  
-}  
-})";
+using test::listing41Json;
+using test::readFile;
+using test::ScopedEnv;
 
 // The smallest valid scene: a light and a homogeneous medium (no file to find).
 json minimalScene() {
@@ -111,37 +53,9 @@ std::string errorOf(const json& scene, const std::vector<std::string>& overrides
   return errorOfText(scene.dump(), overrides);
 }
 
-// Sets (or unsets, with nullopt) an environment variable for one test, then restores it.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, std::optional<std::string> value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    if (value) setenv(name, value->c_str(), 1);
-    else unsetenv(name);
-  }
-  ~ScopedEnv() {
-    if (old_) setenv(name_, old_->c_str(), 1);
-    else unsetenv(name_);
-  }
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
-
 // A fresh folder per test for scene files and (empty) volume files.
 class SceneFiles : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("narval_scene_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    dir_ = fs::canonical(dir_);  // expected paths below are compared as strings
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // Creates an empty file (the loader only checks that volume files exist) and returns its path.
   std::string touch(const std::string& relative) {
     const fs::path p = dir_ / relative;
@@ -151,7 +65,7 @@ class SceneFiles : public ::testing::Test {
   }
   std::string write(const std::string& relative, const std::string& text) {
     const fs::path p = dir_ / relative;
-    std::ofstream(p) << text;
+    test::writeFile(p, text);
     return p.string();
   }
   std::string scenePath() const { return (dir_ / "scene.json").string(); }
@@ -161,21 +75,15 @@ class SceneFiles : public ::testing::Test {
     return scene.dump();
   }
 
-  fs::path dir_;
+  test::TempDir tmp_{"narval_scene"};
+  const fs::path dir_ = fs::canonical(tmp_.path());  // expected paths below are compared as strings
 };
-
-std::string readText(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // ---------------------------------------------------------------- Listing 4.1 and defaults
 
 TEST_F(SceneFiles, Listing41LoadsAsPrinted) {
   const std::string vdb = touch("vdb/wdas_cloud_quarter.vdb");
-  const std::string path = write("scene.json", kListing41);
+  const std::string path = write("scene.json", listing41Json());
   const Scene s = loadScene(path);
 
   EXPECT_EQ(s.sourcePath, path);
@@ -653,7 +561,7 @@ TEST_F(SceneFiles, ShippedScenesParse) {
   const std::string disney = touch("volumes/wdas_cloud_sixteenth.vdb");
   ScopedEnv env("NARVAL_DATA_DIR", (dir_ / "volumes").string());
 
-  const Scene cloud = parseScene(readText(scenes / "cloud.json"), scenePath());
+  const Scene cloud = parseScene(readFile(scenes / "cloud.json"), scenePath());
   EXPECT_TRUE(cloud.warnings.empty());
   EXPECT_EQ(cloud.materials[1].path, cloud128);
   EXPECT_EQ(cloud.materials[1].g, 0.8f);
@@ -668,13 +576,10 @@ TEST_F(SceneFiles, ShippedScenesParse) {
   EXPECT_EQ(cloud.primitives[2].materialName, "key");
 
   // listing_4_1.json is Listing 4.1 with only the grid's path changed.
-  std::string listing = kListing41;
-  const std::string original = "vdb/wdas_cloud_quarter.vdb";
-  listing.replace(listing.find(original), original.size(), "data/cloud_128.vdb");
-  EXPECT_EQ(json::parse(readText(scenes / "listing_4_1.json")), json::parse(listing));
-  EXPECT_TRUE(parseScene(readText(scenes / "listing_4_1.json"), scenePath()).warnings.empty());
+  EXPECT_EQ(json::parse(readFile(scenes / "listing_4_1.json")), json::parse(listing41Json("data/cloud_128.vdb")));
+  EXPECT_TRUE(parseScene(readFile(scenes / "listing_4_1.json"), scenePath()).warnings.empty());
 
-  const Scene d = parseScene(readText(scenes / "disney_cloud.json"), scenePath());
+  const Scene d = parseScene(readFile(scenes / "disney_cloud.json"), scenePath());
   EXPECT_TRUE(d.warnings.empty());
   EXPECT_EQ(d.materials[1].path, disney);
   EXPECT_EQ(d.renderer.spp, 64);
@@ -684,8 +589,8 @@ TEST_F(SceneFiles, ShippedScenesParse) {
 
 TEST(SceneShipped, DisneyCloudFindsTheSharedDataWithoutTheVariable) {
   ScopedEnv env("NARVAL_DATA_DIR", std::nullopt);
-  const fs::path grid = fs::path(NARVAL_DEFAULT_DATA_DIR) / "wdas_cloud_sixteenth.vdb";
-  if (!fs::exists(grid)) GTEST_SKIP() << grid << " is absent";
+  const std::string grid = test::realDataPath("wdas_cloud_sixteenth.vdb");  // the build's default folder
+  NARVAL_REQUIRE_REAL_DATA(grid);
   const Scene s = loadScene(std::string(NARVAL_SOURCE_DIR) + "/scenes/disney_cloud.json");
   EXPECT_EQ(fs::canonical(s.materials[1].path), fs::canonical(grid));
 }
