@@ -10,6 +10,7 @@
 #include "image/atomic_file.h"
 #include "image/image.h"
 #include "render/pathtrace_renderer.h"
+#include "render/realtime_renderer.h"
 #include "scene/input_error.h"
 #include "shared/structs.h"
 
@@ -20,7 +21,7 @@ namespace {
 
 struct RenderArgs {
   std::string scene, out, algorithm, resolution, device, statsJson, localSize = "8x8";
-  int spp = -1, bounces = -1;
+  int spp = -1, bounces = -1, frames = 0;
   long long seed = -1;
   std::vector<std::string> sets;
 };
@@ -82,12 +83,20 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"scene", scene.sourcePath}};
 }
 
+// --frames: per-frame milliseconds, the first frame (build, warm-up) apart.
+nlohmann::json framesJson(const FrameTimings& f) {
+  return {{"frames", f.count},
+          {"first_frame_ms", {{"kernel", f.firstKernelMs}, {"wall", f.firstWallMs}}},
+          {"median", f.medianKernelMs},
+          {"min", f.minKernelMs},
+          {"max", f.maxKernelMs},
+          {"wall", {{"median", f.medianWallMs}, {"min", f.minWallMs}, {"max", f.maxWallMs}}}};
+}
+
 int runRender(const RenderArgs& a) {
-  const Scene scene = loadScene(a.scene, overridesFrom(a));
+  Scene scene = loadScene(a.scene, overridesFrom(a));
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
-  if (scene.renderer.algorithm != "pathtrace")
-    throw inputError(scene.sourcePath, "renderer.algorithm",
-                     "'" + scene.renderer.algorithm + "' is not available yet (available: pathtrace)");
+  const bool realtime = scene.renderer.algorithm != "pathtrace";
   const auto [lx, ly] = parseSize(a.localSize, "--local-size");
 
   fs::path out = a.out.empty() ? fs::path(fs::path(a.scene).stem().string() + ".exr") : fs::path(a.out);
@@ -102,12 +111,19 @@ int runRender(const RenderArgs& a) {
   if (hasGrid) grid = loadGrid(vm->path, vm->gridName);
   ClRuntime rt(a.device);
 
-  ProgressBar bar("rendering " + fs::path(a.scene).filename().string());
+  ProgressBar bar((realtime ? "frames of " : "rendering ") + fs::path(a.scene).filename().string());
   RenderOptions options;
   options.localSizeX = lx;
   options.localSizeY = ly;
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
-  const RenderResult r = renderPathtrace(rt, scene, hasGrid ? &grid : nullptr, options);
+  const DenseGrid* g = hasGrid ? &grid : nullptr;
+  // --frames with the path tracer: K passes of one sample per pixel (a frame each), K spp in all.
+  if (a.frames > 0 && !realtime) {
+    scene.renderer.spp = a.frames;
+    options.samplesPerPass = 1;
+  }
+  const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)
+                                  : renderPathtrace(rt, scene, g, options);
   bar.finish();
   for (const std::string& w : r.warnings) std::cerr << "narval: warning: " << w << "\n";
 
@@ -117,11 +133,20 @@ int runRender(const RenderArgs& a) {
             {"narval:bounces", std::to_string(s.bounces)}, {"narval:seed", std::to_string(scene.renderer.seed)},
             {"narval:scene", scene.sourcePath}, {"narval:device", s.device}});
   writePng(png.string(), r.image, scene.renderer.exposure, scene.renderer.toneMapping);
-  if (!a.statsJson.empty()) writeTextAtomic(a.statsJson, statsJson(s, scene).dump(2) + "\n");
+  if (!a.statsJson.empty()) {
+    nlohmann::json j = statsJson(s, scene);
+    if (a.frames > 0) j["ms_per_frame"] = framesJson(s.frames);
+    writeTextAtomic(a.statsJson, j.dump(2) + "\n");
+  }
 
   if (s.status & STATUS_NAN) std::cerr << "narval: warning: the kernel produced non-finite samples (dropped)\n";
   if (s.status & STATUS_NEGATIVE_PDF) std::cerr << "narval: warning: the kernel met a non-positive pdf\n";
   if (s.status & STATUS_ITERATION_CAP) std::cerr << "narval: warning: a tracking loop hit its iteration cap\n";
+  if (a.frames > 0)
+    std::cout << s.algorithm << ": " << s.frames.count << " frames, first " << s.frames.firstKernelMs
+              << " ms, then median " << s.frames.medianKernelMs << " ms (min " << s.frames.minKernelMs << ", max "
+              << s.frames.maxKernelMs << ") per frame by profiling events, median " << s.frames.medianWallMs
+              << " ms by wall clock\n";
   std::cout << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
             << s.spp << " spp, " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6
             << " Msamples/s on " << s.device << ")\n";
@@ -142,6 +167,9 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("--device", a->device, "Device index or name substring (narval devices)");
   sub->add_option("--seed", a->seed, "Random seed")->check(CLI::Range(0LL, 4294967295LL));
   sub->add_option("--set", a->sets, "Override a scene value: dotted.path=value (repeatable)");
+  sub->add_option("--frames", a->frames,
+                  "Render K frames and report ms per frame (pathtrace: K passes of 1 spp)")
+      ->check(CLI::PositiveNumber);
   sub->add_option("--stats-json", a->statsJson, "Write render statistics as JSON");
   sub->add_option("--local-size", a->localSize, "Work-group shape WxH (default 8x8); never changes the pixels");
   return {sub, [a]() { return runRender(*a); }};

@@ -51,16 +51,20 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   st.buildSeconds = secondsSince(t0);
 
   const cl::NDRange global = paddedGlobalRange(W, H, options), local = localRange(options);
-  const int perPass = pathtraceSamplesPerPass(W, H, spp);
+  const int perPass = options.samplesPerPass > 0 ? options.samplesPerPass : pathtraceSamplesPerPass(W, H, spp);
+  std::vector<double> kernelMs, wallMs;  // per pass: with one sample per pass, per frame
   const auto tLoop = std::chrono::steady_clock::now();
   for (int done = 0; done < spp;) {
     const int count = std::min(perPass, spp - done);
     kernel.setArg(5, cl_uint(done));
     kernel.setArg(6, cl_uint(count));
+    const auto tPass = std::chrono::steady_clock::now();
     cl::Event ev;
     rt.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &ev);
     ev.wait();
-    st.kernelSeconds += eventSeconds(ev);
+    wallMs.push_back(secondsSince(tPass) * 1e3);
+    kernelMs.push_back(eventSeconds(ev) * 1e3);
+    st.kernelSeconds += kernelMs.back() * 1e-3;
     done += count;
     ++st.passes;
     if (options.progress) options.progress(done, spp);
@@ -69,6 +73,7 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   rt.queue.enqueueReadBuffer(sumBuf, CL_TRUE, 0, sums.size() * sizeof(float), sums.data());
   rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &st.status);
   st.seconds = secondsSince(tLoop);
+  st.frames = frameTimings(kernelMs, wallMs);
   st.samplesPerSecond = st.seconds > 0 ? double(pixels) * spp / st.seconds : 0.0;
 
   result.image = imageFromRgba(sums, W, H, float(spp), &st.nanPixels);

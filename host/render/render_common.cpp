@@ -42,6 +42,29 @@ ImageRGB imageFromRgba(const std::vector<float>& rgba, int width, int height, fl
   return img;
 }
 
+namespace {
+// Median, min and max of v (v non-empty); the median of an even count is the mean of the middle two.
+void summarize(std::vector<double> v, double* median, double* lo, double* hi) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  *median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  *lo = v.front();
+  *hi = v.back();
+}
+}  // namespace
+
+FrameTimings frameTimings(const std::vector<double>& kernelMs, const std::vector<double>& wallMs) {
+  FrameTimings t;
+  t.count = int(kernelMs.size());
+  if (kernelMs.empty()) return t;
+  t.firstKernelMs = kernelMs.front();
+  t.firstWallMs = wallMs.front();
+  const size_t skip = kernelMs.size() > 1 ? 1 : 0;
+  summarize({kernelMs.begin() + skip, kernelMs.end()}, &t.medianKernelMs, &t.minKernelMs, &t.maxKernelMs);
+  summarize({wallMs.begin() + skip, wallMs.end()}, &t.medianWallMs, &t.minWallMs, &t.maxWallMs);
+  return t;
+}
+
 double eventSeconds(const cl::Event& e) {
   return double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
          1e-9;

@@ -21,6 +21,9 @@ cl::NDRange localRange(const RenderOptions& options);
 // pixels with a non-finite channel into *nanPixels.
 ImageRGB imageFromRgba(const std::vector<float>& rgba, int width, int height, float divisor, long long* nanPixels);
 
+// Frame statistics from per-frame kernel (profiling) and wall-clock milliseconds.
+FrameTimings frameTimings(const std::vector<double>& kernelMs, const std::vector<double>& wallMs);
+
 // Seconds between an event's start and end (profiling queue).
 double eventSeconds(const cl::Event& e);
 

@@ -12,8 +12,18 @@ namespace narval {
 
 struct RenderOptions {
   int localSizeX = 8, localSizeY = 8;  // work-group shape; never changes the pixels
+  int samplesPerPass = 0;              // pathtrace: 0 = automatic (pathtraceSamplesPerPass)
   // Called after every pass with (samples done, samples requested) per pixel.
   std::function<void(int, int)> progress;
+};
+
+// Per-frame timings of a --frames run. The first frame (program build on first launch, warm-up)
+// is reported apart; median/min/max cover the others (or the first when there is only one).
+struct FrameTimings {
+  int count = 0;
+  double firstKernelMs = 0, firstWallMs = 0;
+  double medianKernelMs = 0, minKernelMs = 0, maxKernelMs = 0;
+  double medianWallMs = 0, minWallMs = 0, maxWallMs = 0;
 };
 
 struct RenderStats {
@@ -27,6 +37,7 @@ struct RenderStats {
   uint32_t status = 0;         // OR of STATUS_* bits reported by the kernels
   long long nanPixels = 0;     // non-finite pixels in the final image
   bool programFromCache = false;
+  FrameTimings frames;         // filled by frame-timed runs (--frames)
 };
 
 struct RenderResult {

@@ -63,6 +63,12 @@ enum class ToneMapping { None, Reinhard, Aces };
 struct RaymarchSettings {
   int steps = 60;
   int shadowSteps = 10;
+  // Multiple-scattering octaves (Wrenninge et al. 2013; Hillaire 2016): octave i uses σs·aⁱ,
+  // σt·bⁱ and g·cⁱ. 1 = plain single scattering. a <= b keeps it energy-conserving.
+  int octaves = 1;
+  float octaveScattering = 0.5f;  // a
+  float octaveExtinction = 0.5f;  // b
+  float octavePhase = 0.5f;       // c
 };
 
 struct LobeSettings {

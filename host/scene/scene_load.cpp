@@ -49,6 +49,8 @@
 // |   seed                  | integer                         |     | 0           | [0, 2^32 - 1]              |
 // |   raymarch.steps        | integer                         |     | 60          | >= 1                       |
 // |   raymarch.shadowSteps  | integer                         |     | 10          | >= 1                       |
+// |   raymarch.octaves      | integer                         |     | 1           | [1, 16]; 1 = off           |
+// |   raymarch.octaveScattering, .octaveExtinction, .octavePhase (a, b, c) | number | | 0.5 | [0, 1], a <= b   |
 // |   lobe.depthFactor      | number                          |     | 20          | >= 0                       |
 // |   lobe.lobePoints       | integer                         |     | 30          | >= 1                       |
 // |   lobe.lobeRadius       | number, world units             |     | 1           | >= 0                       |
@@ -152,6 +154,12 @@ int readInt(ObjectReader& r, const std::string& name, int fallback, int64_t lo, 
 float readNonNegative(ObjectReader& r, const std::string& name, float fallback) {
   const float v = r.getFloat(name, fallback);
   checkNonNegative(r.context(), r.keyOf(name), v);
+  return v;
+}
+
+float readUnitInterval(ObjectReader& r, const std::string& name, float fallback) {
+  const float v = r.getFloat(name, fallback);
+  if (!(v >= 0 && v <= 1)) r.context().fail(r.keyOf(name), "must be in [0, 1], got " + formatNumber(v));
   return v;
 }
 
@@ -292,6 +300,14 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
     ObjectReader m(ctx, *v, r.keyOf("raymarch"));
     s.raymarch.steps = readInt(m, "steps", s.raymarch.steps, 1);
     s.raymarch.shadowSteps = readInt(m, "shadowSteps", s.raymarch.shadowSteps, 1);
+    s.raymarch.octaves = readInt(m, "octaves", s.raymarch.octaves, 1, 16);
+    s.raymarch.octaveScattering = readUnitInterval(m, "octaveScattering", s.raymarch.octaveScattering);
+    s.raymarch.octaveExtinction = readUnitInterval(m, "octaveExtinction", s.raymarch.octaveExtinction);
+    s.raymarch.octavePhase = readUnitInterval(m, "octavePhase", s.raymarch.octavePhase);
+    if (s.raymarch.octaveScattering > s.raymarch.octaveExtinction)
+      ctx.fail(m.keyOf("octaveScattering"), "must not exceed octaveExtinction (" +
+                                                formatNumber(s.raymarch.octaveExtinction) +
+                                                ") or the octaves add energy");
     m.reportUnknown();
   }
   if (const json* v = r.find("lobe")) {

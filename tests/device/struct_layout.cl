@@ -27,7 +27,12 @@
   S(scene_params) F(scene_params, camera) F(scene_params, camera.height) F(scene_params, medium)    \
   F(scene_params, medium.sigma_s) F(scene_params, medium.grey) F(scene_params, background)         \
   F(scene_params, has_medium) F(scene_params, num_lights) F(scene_params, max_bounces)             \
-  F(scene_params, seed)
+  F(scene_params, seed)                                                                            \
+  S(realtime_params) F(realtime_params, steps) F(realtime_params, shadow_steps)                   \
+  F(realtime_params, octaves) F(realtime_params, octave_a) F(realtime_params, octave_b)           \
+  F(realtime_params, octave_c) F(realtime_params, depth_factor) F(realtime_params, lobe_radius)   \
+  F(realtime_params, lobe_points) F(realtime_params, pad0) F(realtime_params, pad1)               \
+  F(realtime_params, pad2)
 
 #ifdef __OPENCL_C_VERSION__
 

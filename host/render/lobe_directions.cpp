@@ -1,0 +1,23 @@
+#include "render/lobe_directions.h"
+
+#include "shared/phase.h"
+#include "shared/rng.h"
+
+namespace narval {
+
+std::vector<nv_float4> lobeDirections(int n, float g, uint32_t seed) {
+  std::vector<nv_float4> dirs;
+  dirs.reserve(size_t(n));
+  const vec3 z = vec3_make(0.0f, 0.0f, 1.0f);
+  for (int i = 0; i < n; ++i) {
+    // Pixel index 0xFFFFFFFF: a stream no pixel of an image uses.
+    rng_state rng = rng_init(seed, 0xFFFFFFFFu, uint32_t(i));
+    const float u1 = (float(i) + rng_uniform(&rng)) / float(n);
+    const float u2 = rng_uniform(&rng);
+    const vec3 d = sample_direction_around(z, phase_hg_sample_cos(g, u1), u2);
+    dirs.push_back(nv_float4{d.x, d.y, d.z, 0.0f});
+  }
+  return dirs;
+}
+
+}  // namespace narval

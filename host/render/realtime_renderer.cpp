@@ -1,0 +1,91 @@
+#include "render/realtime_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "render/device_scene.h"
+#include "render/lobe_directions.h"
+#include "render/render_common.h"
+#include "scene/input_error.h"
+
+namespace narval {
+
+realtime_params realtimeParams(const Scene& scene) {
+  const RendererSettings& r = scene.renderer;
+  const bool lobe = r.algorithm == "lobe";
+  realtime_params p{};
+  p.steps = r.raymarch.steps;
+  p.shadow_steps = lobe ? r.lobe.shadowSteps : r.raymarch.shadowSteps;
+  p.octaves = r.raymarch.octaves;
+  p.octave_a = r.raymarch.octaveScattering;
+  p.octave_b = r.raymarch.octaveExtinction;
+  p.octave_c = r.raymarch.octavePhase;
+  p.depth_factor = r.lobe.depthFactor;
+  p.lobe_radius = r.lobe.lobeRadius;
+  p.lobe_points = r.lobe.lobePoints;
+  return p;
+}
+
+RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, int frames,
+                            const RenderOptions& options) {
+  const std::string& algorithm = scene.renderer.algorithm;
+  if (algorithm != "raymarch" && algorithm != "lobe")
+    throw std::invalid_argument("renderRealtime: not a real-time algorithm: " + algorithm);
+  const auto t0 = std::chrono::steady_clock::now();
+  const int W = scene.renderer.width, H = scene.renderer.height;
+  const DeviceSceneBuffers dev(rt, scene, grid);
+
+  RenderResult result;
+  result.warnings = dev.scene.warnings;
+  result.stats = initialStats(algorithm, rt, scene);
+  RenderStats& st = result.stats;
+  st.spp = 1;
+
+  const realtime_params params = realtimeParams(scene);
+  const scene_params& sp = dev.scene.params;
+  const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
+  std::vector<nv_float4> dirs = algorithm == "lobe" ? lobeDirections(params.lobe_points, g, scene.renderer.seed)
+                                                    : std::vector<nv_float4>(1, nv_float4{0, 0, 1, 0});
+  cl::Program program =
+      buildProgram(rt, algorithm + ".cl", dev.scene.buildOptions, nullptr, &st.programFromCache);
+  cl::Kernel kernel(program, algorithm.c_str());
+  const size_t pixels = size_t(W) * size_t(H);
+  cl::Buffer paramBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(params),
+                      const_cast<realtime_params*>(&params));
+  cl::Buffer dirBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4), dirs.data());
+  cl::Buffer outBuf(rt.context, CL_MEM_WRITE_ONLY, pixels * 4 * sizeof(float));
+  cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
+  rt.queue.enqueueFillBuffer(statusBuf, cl_uint(0), 0, sizeof(cl_uint));
+  dev.bind(kernel);
+  kernel.setArg(3, paramBuf);
+  kernel.setArg(4, dirBuf);
+  kernel.setArg(5, outBuf);
+  kernel.setArg(6, statusBuf);
+  rt.queue.finish();
+  st.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // One launch per frame, each timed by its profiling event and by the wall clock around it.
+  const cl::NDRange global = paddedGlobalRange(W, H, options), local = localRange(options);
+  std::vector<double> kernelMs, wallMs;
+  for (int f = 0; f < std::max(1, frames); ++f) {
+    const auto tf = std::chrono::steady_clock::now();
+    cl::Event ev;
+    rt.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &ev);
+    ev.wait();
+    wallMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tf).count());
+    kernelMs.push_back(eventSeconds(ev) * 1e3);
+    if (options.progress) options.progress(f + 1, std::max(1, frames));
+  }
+  std::vector<float> rgba(pixels * 4);
+  rt.queue.enqueueReadBuffer(outBuf, CL_TRUE, 0, rgba.size() * sizeof(float), rgba.data());
+  rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &st.status);
+  st.passes = int(kernelMs.size());
+  st.frames = frameTimings(kernelMs, wallMs);
+  for (double ms : kernelMs) st.kernelSeconds += ms * 1e-3;
+  for (double ms : wallMs) st.seconds += ms * 1e-3;
+  st.samplesPerSecond = st.seconds > 0 ? double(pixels) * st.passes / st.seconds : 0.0;
+  result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
+  return result;
+}
+
+}  // namespace narval
