@@ -147,11 +147,11 @@ TEST_F(Cli, RealFireHasNoDensityGrid) {
   EXPECT_NE(r.err.find("no grid named 'density' (the file has: flames, temperature)"), std::string::npos) << r.err;
 }
 
-TEST_F(Cli, UnavailableAlgorithmAndBadOptions) {
+TEST_F(Cli, UnknownAlgorithmAndBadOptions) {
   writeVdb((dir_ / "cloud.vdb").string(), makeCloud(8, 1));
   write("scene.json", listing41Json("cloud.vdb"));
-  expectBadInput(*this, run("render scene.json --algorithm raymarch"),
-                 "narval: scene.json: renderer.algorithm: 'raymarch' is not available yet (available: pathtrace)");
+  expectBadInput(*this, run("render scene.json --algorithm photons"),
+                 "narval: scene.json: renderer.algorithm: unknown value \"photons\" (allowed: pathtrace, raymarch, lobe)");
   expectBadInput(*this, run("render scene.json --resolution 10by3"),
                  "narval: --resolution: expected WIDTHxHEIGHT with positive integers, got '10by3'");
   EXPECT_EQ(run("render scene.json --spp -3").code, 2);
