@@ -1,0 +1,175 @@
+/* lobe.h: the Lobe Estimator (dissertation ch. 6, Eq. 7; DESIGN.md "lobe"), one deterministic
+ * estimate per pixel:
+ *
+ *   L = L_b · (1/n) Σ_i Tr(x0 → P_i)
+ *     + albedo ⊙ Σ_k (1/n) Σ_i p(cos θ_i) · Tr(P_i → light_k) · I_k / |light_k − P_i|²
+ *
+ * Parameters (realtime_params, structs.h; scene keys renderer.lobe / renderer.raymarch):
+ *   steps         samples of the first-hit search over the view ray's segment in the box
+ *                 (renderer.raymarch.steps, default 60), then LOBE_BISECTIONS bisection steps
+ *   shadow_steps  midpoint samples of every transmittance integral (renderer.lobe.shadowSteps, 100)
+ *   depth_factor  lobe centre depth in mean free paths of unit density (default 20)
+ *   lobe_radius   |P_i − c| in world units (default 1)
+ *   lobe_points   n, the directions in `dirs` (default 30)
+ *
+ * 1. x0: the first point of the view ray inside the box where the density is above zero. The
+ *    search samples t0 + j·Δ, j = 0..steps, Δ = (t1 − t0)/steps, and bisects the step where the
+ *    density first becomes positive; features thinner than Δ between two samples can be missed.
+ * 2. c = x0 + t·ω, t = depth_factor / σ̄t, σ̄t the mean over channels of (σa + σs) for unit density
+ *    (D included). Clamp: t never exceeds the rest of the view ray's segment inside the box, so c
+ *    stays "a point inside the volume" as ch. 6 describes it (the box is the medium's support; past
+ *    it nothing attenuates and the lobe would sample unshadowed light). This also keeps σ̄t = 0 or
+ *    tiny finite without dividing by it: t = depth_factor/σ̄t only when that is below the rest of
+ *    the segment, tested as depth_factor < σ̄t·rest.
+ * 3. d_i = the host's canonical directions (HG(g) about +Z, host/render/lobe_directions.cpp)
+ *    rotated onto ω. P_i = c + r·d_i, exactly DESIGN.md. Sign check: the light that reaches c from
+ *    P_i travels along c − P_i = −r·d_i, and leaves c towards the camera along −ω, so the phase
+ *    angle at c has cos = dot(−d_i, −ω) = dot(d_i, ω), which is HG(g)-distributed: importance
+ *    sampling of the phase lobe of light arriving at c and scattered to the camera. For g > 0 the
+ *    d_i point along ω, i.e. the P_i lie beyond c as seen from the camera ("behind c"): forward
+ *    scattering, light coming from behind the medium is bright (dissertation Fig. 2.10). DESIGN.md's
+ *    two statements agree; the dissertation's GLSL flips this sign (a bug, not followed).
+ *    The frame about ω is built from the camera's `right` vector (its component perpendicular to
+ *    ω), not vec3_basis(ω): the lobe is then attached to the camera, so moving camera and scene
+ *    rigidly together leaves the image unchanged, and the frame varies smoothly across the image
+ *    (vec3_basis flips where ω.z changes sign, which would print a seam).
+ * 4. Transmittances by march_transmittance (midpoint rule, true step lengths, all channels, only
+ *    the part inside the box), lights as points (march_light_as_point: a rectangle is a point at its
+ *    centre with intensity Le·A·max(0, cos θ_light), as DESIGN.md allows for real-time kernels).
+ *    Shadow rays see only the medium, not other rectangles. cos θ_i = dot(normalize(P_i − light),
+ *    −d_i): light propagating from the light to P_i, then from P_i towards c. albedo = σs/σt per
+ *    channel (0 where σt = 0).
+ * No medium, a ray that misses the box (or meets a rectangle light first), or no density > 0 on the
+ * segment: L = L_b exactly (march_background). Means divide by n (not multiply by 1/n), so n
+ * transmittances of exactly 1 give exactly L_b. */
+#ifndef NARVAL_LOBE_H
+#define NARVAL_LOBE_H
+
+#include "shared/march.h"
+#include "shared/phase.h"
+
+/* Halvings of the first-hit step: x0 is placed within Δ/64 past the density's zero crossing. */
+#define LOBE_BISECTIONS 6
+
+/* The pinhole primary ray through image point (px, py) (pixel units, (0,0) the top-left corner):
+ * camera.h's mapping without the thin lens (DESIGN.md: the real-time kernels are pinhole). */
+static inline vec3 lobe_view_dir(NV_CONSTANT const camera_params* c, float px, float py) {
+  const float sx = (2.0f * px / (float)c->width - 1.0f) * c->tan_half_vfov * c->aspect;
+  const float sy = (1.0f - 2.0f * py / (float)c->height) * c->tan_half_vfov;
+  const vec3 fwd = vec3_from4(c->forward), right = vec3_from4(c->right), up = vec3_from4(c->up);
+  return vec3_normalize(vec3_add(fwd, vec3_add(vec3_scale(right, sx), vec3_scale(up, sy))));
+}
+
+/* First parameter in [seg.t0, seg.t1] where the density is above zero; 0 when there is none. */
+static inline int lobe_first_hit(GRID_PARAM, NV_PRIVATE const medium_segment* seg, int steps,
+                                 NV_PRIVATE float* t_hit) {
+  const int n = steps > 0 ? steps : 1;
+  const float dt = (seg->t1 - seg->t0) / (float)n;
+  for (int j = 0; j <= n; ++j) {
+    const float t = j == n ? seg->t1 : seg->t0 + (float)j * dt;
+    if (!(grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t)) > 0.0f)) continue;
+    if (j == 0) {
+      *t_hit = t;
+      return 1;
+    }
+    /* Invariant: density(lo) == 0 < density(hi). */
+    float lo = seg->t0 + (float)(j - 1) * dt, hi = t;
+    for (int b = 0; b < LOBE_BISECTIONS; ++b) {
+      const float mid = 0.5f * (lo + hi);
+      if (grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, mid)) > 0.0f)
+        hi = mid;
+      else
+        lo = mid;
+    }
+    *t_hit = hi;
+    return 1;
+  }
+  return 0;
+}
+
+/* Transmittance along the straight segment a → b (1 when they coincide). */
+static inline vec3 lobe_transmittance_between(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 a, vec3 b,
+                                              int steps) {
+  const vec3 ab = vec3_sub(b, a);
+  const float dist = vec3_length(ab);
+  if (!(dist > 0.0f)) return vec3_splat(1.0f);
+  return march_transmittance(m, GRID_ARG, a, vec3_scale(ab, 1.0f / dist), dist, steps);
+}
+
+/* Radiance of the view ray from `origin` along unit `dir`. `right` is the camera's unit right
+ * vector (the lobe frame's reference, see the header comment); `dirs` holds p->lobe_points unit
+ * directions about +Z. */
+static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                 GRID_PARAM, NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
+                                 vec3 origin, vec3 dir, vec3 right) {
+  /* L_b, and the view ray stops at the first rectangle it meets (rectangles are opaque). */
+  const vec3 Lb = march_background(s, lights, origin, dir);
+  if (!s->has_medium || p->lobe_points < 1) return Lb;
+  float t_surf;
+  int front = 0;
+  intersect_lights(lights, s->num_lights, origin, dir, 0.0f, -1, &t_surf, &front);
+  NV_CONSTANT const medium_params* m = &s->medium;
+  medium_segment seg;
+  if (!medium_intersect(m, origin, dir, 0.0f, t_surf, &seg)) return Lb;
+
+  /* 1. First hit. */
+  float t_x0;
+  if (!lobe_first_hit(GRID_ARG, &seg, p->steps, &t_x0)) return Lb;
+  const vec3 x0 = vec3_madd(origin, dir, t_x0);
+
+  /* 2. Lobe centre, depth clamped to the rest of the segment inside the box. */
+  const vec3 sig_s = vec3_from4(m->sigma_s);
+  const vec3 sig_t = vec3_add(vec3_from4(m->sigma_a), sig_s);
+  const float mean_sigma_t = vec3_average(sig_t);
+  const float rest = seg.t1 - t_x0;
+  const float depth = p->depth_factor < mean_sigma_t * rest ? p->depth_factor / mean_sigma_t : rest;
+  const vec3 c = vec3_madd(x0, dir, depth);
+  const vec3 albedo = vec3_make(sig_t.x > 0.0f ? sig_s.x / sig_t.x : 0.0f, sig_t.y > 0.0f ? sig_s.y / sig_t.y : 0.0f,
+                                sig_t.z > 0.0f ? sig_s.z / sig_t.z : 0.0f);
+
+  /* 3. Frame (t, b, ω) from the camera's right vector; (t, b, ω) is right-handed. */
+  const vec3 tx = vec3_normalize(vec3_madd(right, dir, -vec3_dot(right, dir)));
+  const vec3 ty = vec3_cross(dir, tx);
+
+  /* 4. Sums over the lobe points. */
+  const int n = p->lobe_points;
+  vec3 tr_sum = vec3_splat(0.0f), in_sum = vec3_splat(0.0f);
+  for (int i = 0; i < n; ++i) {
+    const nv_float4 q = dirs[i];
+    const vec3 d = vec3_add(vec3_add(vec3_scale(tx, q.x), vec3_scale(ty, q.y)), vec3_scale(dir, q.z));
+    const vec3 P = vec3_madd(c, d, p->lobe_radius);
+    tr_sum = vec3_add(tr_sum, lobe_transmittance_between(m, GRID_ARG, x0, P, p->shadow_steps));
+    const vec3 w_out = vec3_scale(d, -1.0f); /* from P_i towards c */
+    for (int k = 0; k < s->num_lights; ++k) {
+      vec3 to_light, I;
+      float dist;
+      if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
+      /* w_in: the light's propagation direction, light → P_i. */
+      const float f = phase_eval(m->phase, m->g, vec3_scale(to_light, -1.0f), w_out);
+      if (!(f > 0.0f)) continue;
+      const vec3 tr = march_transmittance(m, GRID_ARG, P, to_light, dist, p->shadow_steps);
+      in_sum = vec3_add(in_sum, vec3_scale(vec3_mul(tr, I), f / (dist * dist)));
+    }
+  }
+  const float fn = (float)n;
+  const vec3 tr_mean = vec3_make(tr_sum.x / fn, tr_sum.y / fn, tr_sum.z / fn);
+  const vec3 in_mean = vec3_make(in_sum.x / fn, in_sum.y / fn, in_sum.z / fn);
+  return vec3_add(vec3_mul(Lb, tr_mean), vec3_mul(albedo, in_mean));
+}
+
+/* The pixel (px, py): ray through its centre (deterministic, no jitter). Non-finite results are
+ * reported in *status and replaced by 0. */
+static inline vec3 lobe_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights, GRID_PARAM,
+                              NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs, int px, int py,
+                              NV_PRIVATE uint* status) {
+  NV_CONSTANT const camera_params* cam = &s->camera;
+  const vec3 dir = lobe_view_dir(cam, (float)px + 0.5f, (float)py + 0.5f);
+  const vec3 L = lobe_radiance(s, lights, GRID_ARG, p, dirs, vec3_from4(cam->position), dir, vec3_from4(cam->right));
+  if (!vec3_is_finite(L)) {
+    *status |= STATUS_NAN;
+    return vec3_splat(0.0f);
+  }
+  return L;
+}
+
+#endif
