@@ -16,17 +16,24 @@ static inline vec3 march_sigma_t(NV_CONSTANT const medium_params* m, GRID_PARAM,
   return vec3_scale(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)), rho);
 }
 
-/* Transmittance from `origin` over `dist` along unit `dir`: `steps` equal steps over the part of
- * the segment inside the box, σt sampled at each step's midpoint, exp(-Σ σt·Δ). 1 outside the box. */
-static inline vec3 march_transmittance(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
+/* Optical depth τ from `origin` over `dist` along unit `dir`: `steps` equal steps over the part of
+ * the segment inside the box, σt sampled at each step's midpoint, Σ σt·Δ. 0 outside the box. The
+ * ray marcher's octaves need τ itself (exp(−bⁱτ)), which survives where exp(−τ) underflows. */
+static inline vec3 march_optical_depth(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
                                        float dist, int steps) {
   medium_segment seg;
-  if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) return vec3_splat(1.0f);
+  if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) return vec3_splat(0.0f);
   const float dt = (seg.t1 - seg.t0) / (float)steps;
   vec3 tau = vec3_splat(0.0f);
   for (int i = 0; i < steps; ++i)
     tau = vec3_add(tau, march_sigma_t(m, GRID_ARG, &seg, seg.t0 + ((float)i + 0.5f) * dt));
-  return vec3_exp_neg(vec3_scale(tau, dt));
+  return vec3_scale(tau, dt);
+}
+
+/* Transmittance exp(−τ) over the same quadrature (1 outside the box). */
+static inline vec3 march_transmittance(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
+                                       float dist, int steps) {
+  return vec3_exp_neg(march_optical_depth(m, GRID_ARG, origin, dir, dist, steps));
 }
 
 /* A light as seen from x, as a point: unit direction to it, distance, and the intensity I (W/sr)

@@ -1,0 +1,154 @@
+/* raymarch.h: real-time single scattering by ray marching (DESIGN.md "raymarch"; Hillaire 2015,
+ * "Physically based and unified volumetric rendering in Frostbite"), with the multiple-scattering
+ * octave approximation (Wrenninge et al. 2013, "Oz: the great and volumetric"; Hillaire 2016,
+ * "Physically based sky, atmosphere and cloud rendering in Frostbite"). Deterministic: one ray
+ * through the pixel centre, fixed quadrature, no random numbers.
+ *
+ * Parameters (realtime_params):
+ * | field        | meaning                                                                  |
+ * |--------------|--------------------------------------------------------------------------|
+ * | steps        | samples over the view ray's segment inside the box, each of true length   |
+ * | shadow_steps | samples per shadow ray, clipped to the box                                |
+ * | octaves      | N; 1 = plain single scattering                                            |
+ * | octave_a/b/c | per-octave scale of σs, of the shadow ray's σt, of the HG g               |
+ *
+ * Per view ray o + t·d, its segment [t0, t1] inside the box (clipped at the rectangle light it
+ * hits, as the path tracer does), Δ = (t1 − t0)/steps, sample x_k at the midpoint of step k:
+ *   S_k = σs(x_k) ⊙ Σ_lights (I/d²) ⊙ Σ_{i<N} aⁱ · p(g·cⁱ, μ) · exp(−bⁱ·τ(x_k → light))
+ *   L  += T ⊙ (S_k − S_k ⊙ e^{−σt(x_k)·Δ}) / σt(x_k)      (energy-conserving step, exact for
+ *   T  ⊙= e^{−σt(x_k)·Δ}                                     S and σt constant over the step)
+ * and the pixel is L + T ⊙ L_b (L_b: march_background, what the ray sees with the medium removed).
+ * Lights are points (march_light_as_point: a rectangle is a point at its centre with intensity
+ * Le·A·max(0, cos θ_light), the approximation DESIGN.md allows here); other emitters do not block
+ * shadow rays. μ is the cosine between the light's propagation direction (light → x) and the
+ * scattered one (x → camera, −d): dot(d, direction to the light), as in pathtrace_direct.
+ *
+ * Octaves: octave i scatters with σs·aⁱ, sees the light through the shadow transmittance with
+ * extinction σt·bⁱ, i.e. Tr^(bⁱ) = exp(−bⁱ·τ) with τ computed once, and uses the phase function
+ * with g·cⁱ; the view ray's transmittance T is not scaled. Octave 0 is plain single scattering and
+ * is computed by exactly the same arithmetic whether N is 1 or more; the others are added only
+ * when N > 1, so the a, b, c values cannot change an N = 1 image.
+ * Bound: every octave term is ≥ 0, so N octaves are never darker than one. With b = c = 1 each
+ * octave is octave 0 scaled by aⁱ, so L_N = L_1 · Σ_{i<N} aⁱ = L_1 · (1 − a^N)/(1 − a) ≤ L_1/(1 − a)
+ * (a < 1; the loader keeps a ≤ b ≤ 1). For b < 1 or c < 1 no multiple of L_1 bounds L_N: Tr^(bⁱ)
+ * ≥ Tr can be larger by any factor deep in a dense medium (that is the point of the octaves), and
+ * HG with a smaller |g| exceeds HG(g) away from the peak. What does hold for any a, b, c: since
+ * exp(−bⁱτ) ≤ 1 and p(g', μ) ≤ p_max = (1 + |g|)/(4π(1 − |g|)²) for |g'| ≤ |g|,
+ *   L_N − T ⊙ L_b ≤ p_max · Σ_{i<N} aⁱ · U ≤ p_max/(1 − a) · U,
+ * U the same march with the phase function and the shadow transmittance replaced by 1: bounded
+ * whenever a < 1. (a ≤ b keeps each octave's effective albedo σs·aⁱ/(σt·bⁱ) ≤ σs/σt.)
+ *
+ * Empty space: the march is written per interval (raymarch_interval marches [t0, t1] with a given
+ * number of steps), so a majorant/occupancy grid can later skip empty intervals and march only the
+ * occupied ones; for now the whole box segment is one interval. Samples of zero density change
+ * nothing (S = 0, e^{−0} = 1) and skip the light loop. */
+#ifndef NARVAL_RAYMARCH_H
+#define NARVAL_RAYMARCH_H
+
+#include "shared/camera.h"
+#include "shared/march.h"
+#include "shared/phase.h"
+
+/* Below this optical depth per step, (1 − e^{−x})/x is evaluated by its Taylor series: the direct
+ * form loses |rounding of e^{−x}|/x to cancellation (≤ 3 ulp·2⁻²³/x ≈ 4e-6 relative at x = 0.1,
+ * less above), the series 1 − x/2 + x²/6 − x³/24 + x⁴/120 is off by ≤ x⁵/720 ≈ 1.4e-8 below it, and
+ * at x = 0 (σt = 0) it is exactly 1, so the step integral is exactly S·Δ, never 0/0. */
+#define RAYMARCH_SERIES_MAX 0.1f
+
+/* (1 − e^{−x})/x for x ≥ 0, given e = e^{−x}: the energy-conserving step integral
+ * (S − S·e^{−σtΔ})/σt = S·Δ·raymarch_step_weight(σtΔ). */
+static inline float raymarch_step_weight(float x, float e) {
+  if (x < RAYMARCH_SERIES_MAX)
+    return 1.0f - x * (0.5f - x * (1.0f / 6.0f - x * (1.0f / 24.0f - x * (1.0f / 120.0f))));
+  return (1.0f - e) / x;
+}
+
+/* Light arriving at x and scattered towards the camera, per unit σs: Σ_lights (I/d²) ⊙
+ * Σ_{i<N} aⁱ p(g cⁱ, μ) exp(−bⁱ τ). view_dir points away from the camera. */
+static inline vec3 raymarch_light_sum(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                      GRID_PARAM, NV_CONSTANT const realtime_params* rp, vec3 x, vec3 view_dir) {
+  NV_CONSTANT const medium_params* m = &s->medium;
+  vec3 sum = vec3_splat(0.0f);
+  for (int l = 0; l < s->num_lights; ++l) {
+    vec3 dir, I;
+    float dist;
+    if (!march_light_as_point(&lights[l], x, &dir, &dist, &I)) continue;
+    const vec3 tau = march_optical_depth(m, GRID_ARG, x, dir, dist, rp->shadow_steps);
+    /* Octave 0: plain single scattering. */
+    vec3 oct = vec3_scale(vec3_exp_neg(tau), phase_eval(m->phase, m->g, view_dir, dir));
+    if (rp->octaves > 1) {
+      float ai = 1.0f, bi = 1.0f, ci = 1.0f;
+      for (int i = 1; i < rp->octaves; ++i) {
+        ai *= rp->octave_a;
+        bi *= rp->octave_b;
+        ci *= rp->octave_c;
+        const float p = phase_eval(m->phase, m->g * ci, view_dir, dir);
+        oct = vec3_add(oct, vec3_scale(vec3_exp_neg(vec3_scale(tau, bi)), ai * p));
+      }
+    }
+    sum = vec3_add(sum, vec3_mul(vec3_scale(I, 1.0f / (dist * dist)), oct));
+  }
+  return sum;
+}
+
+/* What a march has gathered so far: in-scattered radiance L and view-ray transmittance T. */
+typedef struct raymarch_accum {
+  vec3 L, T;
+} raymarch_accum;
+
+/* Marches [t0, t1] of the view ray origin + t·dir (its box segment `seg`, for index-space
+ * lookups) in `steps` steps of true length (t1 − t0)/steps, sampled at their midpoints. */
+static inline void raymarch_interval(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                     GRID_PARAM, NV_CONSTANT const realtime_params* rp,
+                                     NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, float t0, float t1,
+                                     int steps, NV_PRIVATE raymarch_accum* acc) {
+  NV_CONSTANT const medium_params* m = &s->medium;
+  const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
+  const float dt = (t1 - t0) / (float)steps;
+  for (int k = 0; k < steps; ++k) {
+    const float t = t0 + ((float)k + 0.5f) * dt;
+    const float rho = grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t));
+    if (!(rho > 0.0f)) continue; /* S = 0 and e^{−0} = 1: the step would change nothing */
+    const vec3 sigma_t = vec3_scale(vec3_add(sa, ss), rho); /* as march_sigma_t */
+    const vec3 sigma_s = vec3_scale(ss, rho);
+    vec3 S = vec3_splat(0.0f);
+    if (!vec3_is_zero(sigma_s))
+      S = vec3_mul(sigma_s, raymarch_light_sum(s, lights, GRID_ARG, rp, vec3_madd(origin, dir, t), dir));
+    const vec3 x = vec3_scale(sigma_t, dt);
+    const vec3 e = vec3_exp_neg(x);
+    const vec3 w = vec3_make(raymarch_step_weight(x.x, e.x), raymarch_step_weight(x.y, e.y),
+                             raymarch_step_weight(x.z, e.z));
+    acc->L = vec3_add(acc->L, vec3_mul(acc->T, vec3_scale(vec3_mul(S, w), dt)));
+    acc->T = vec3_mul(acc->T, e);
+  }
+}
+
+/* Radiance through the centre of pixel (px, py). Pinhole: the ray leaves the lens centre. */
+static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                  GRID_PARAM, NV_CONSTANT const realtime_params* rp, int px, int py,
+                                  NV_PRIVATE uint* status) {
+  const ray3 r = camera_ray(&s->camera, (float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f);
+  const vec3 Lb = march_background(s, lights, r.origin, r.dir);
+  vec3 L = Lb;
+  if (s->has_medium) {
+    /* The medium behind the emitter the ray hits is hidden by it (the path tracer's rule). */
+    float t_surf;
+    int front = 0;
+    intersect_lights(lights, s->num_lights, r.origin, r.dir, 0.0f, -1, &t_surf, &front);
+    medium_segment seg;
+    if (medium_intersect(&s->medium, r.origin, r.dir, 0.0f, t_surf, &seg)) {
+      raymarch_accum acc;
+      acc.L = vec3_splat(0.0f);
+      acc.T = vec3_splat(1.0f);
+      raymarch_interval(s, lights, GRID_ARG, rp, &seg, r.origin, r.dir, seg.t0, seg.t1, rp->steps, &acc);
+      L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
+    }
+  }
+  if (!vec3_is_finite(L)) {
+    *status |= STATUS_NAN;
+    return vec3_splat(0.0f);
+  }
+  return L;
+}
+
+#endif
