@@ -148,8 +148,13 @@ int runRender(const RenderArgs& a) {
               << s.frames.maxKernelMs << ") per frame by profiling events, median " << s.frames.medianWallMs
               << " ms by wall clock\n";
   std::cout << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
-            << s.spp << " spp, " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6
-            << " Msamples/s on " << s.device << ")\n";
+            << s.algorithm << ", ";
+  if (realtime)
+    std::cout << s.frames.count << " frame(s), " << s.frames.medianKernelMs << " ms per frame";
+  else
+    std::cout << s.spp << " spp, " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6
+              << " Msamples/s";
+  std::cout << " on " << s.device << ")\n";
   return 0;
 }
 

@@ -207,3 +207,32 @@ TEST_F(Cli, DragonTransformWarningInUnitGridSpaceOnly) {
 
 }  // namespace
 }  // namespace narval
+
+namespace narval {
+namespace {
+
+// --frames K: K timed launches; the first (program build on first launch, warm-up) reported apart,
+// median/min/max over the other K-1, so min <= median <= max. Every algorithm accepts it; the
+// path tracer's frame is one pass of 1 spp, so its image holds K spp.
+TEST_F(Cli, FramesReportMillisecondsPerFrameForEveryAlgorithm) {
+  writeVdb((dir_ / "cloud.vdb").string(), makeCloud(16, 1));
+  write("scene.json", test::listing41Json("cloud.vdb"));
+  for (const std::string algorithm : {"raymarch", "lobe", "pathtrace"}) {
+    const RunResult r = run("render scene.json -o " + algorithm + ".exr --resolution 16x8 --frames 3 --algorithm " +
+                            algorithm + " --stats-json " + algorithm + ".json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json s = nlohmann::json::parse(test::readFile((dir_ / (algorithm + ".json")).string()));
+    EXPECT_EQ(s["algorithm"], algorithm);
+    const nlohmann::json& f = s["ms_per_frame"];
+    EXPECT_EQ(f["frames"], 3);
+    EXPECT_GT(f["first_frame_ms"]["kernel"].get<double>(), 0.0);
+    EXPECT_LE(f["min"].get<double>(), f["median"].get<double>());
+    EXPECT_LE(f["median"].get<double>(), f["max"].get<double>());
+    EXPECT_GT(f["min"].get<double>(), 0.0);
+    if (algorithm == "pathtrace") EXPECT_EQ(s["spp"], 3);
+    EXPECT_TRUE(fs::exists(dir_ / (algorithm + ".png")));
+  }
+}
+
+}  // namespace
+}  // namespace narval
