@@ -1,0 +1,196 @@
+/* majorant.h: a coarse majorant grid over the medium box and the 3D DDA that walks it (pbrt-v4's
+ * MajorantGrid / DDAMajorantIterator, written as a plain-C iterator a kernel loops over).
+ *
+ * The box [0, nx]×[0, ny]×[0, nz] in grid index space is cut into cells_x×cells_y×cells_z equal
+ * cells of cell_size index units; cell (i, j, k) covers [i, i+1]·cell_size.x × ... and its value
+ * cell_max[i + cells_x·(j + cells_y·k)] bounds the trilinear DENSITY anywhere in that closed cell
+ * (host/volume/majorant_grid.cpp builds it and proves the bound). σ̄ for a cell is
+ * max-channel σt · cell value · MAJORANT_MARGIN, applied by the kernel.
+ *
+ * The DDA yields, for an index-space ray o + t·d over [t0, t1], the cells it passes through in
+ * order as segments [seg_t0, seg_t1] with the cell's value:
+ *
+ *   majorant_iter it = majorant_iter_begin(grid, o, d, t0, t1);
+ *   float s0, s1, smax;
+ *   while (majorant_iter_next(&it, cell_max, &s0, &s1, &smax)) { ... }
+ *
+ * Contract (tests/unit/majorant_grid_test.cpp):
+ * - the segments are contiguous and increasing: the first seg_t0 is t0, each seg_t1 is the next
+ *   seg_t0, the last seg_t1 is t1, every segment has seg_t1 > seg_t0 (bit-exact: t values are
+ *   handed on, never recomputed). t0 >= t1, or a non-finite t0/t1, yields nothing.
+ * - a cell the ray passes through with positive length is yielded; a cell it only touches (an
+ *   edge or corner crossed exactly) is not: ties between axes step every tied axis at once, so no
+ *   zero-length segment appears. A ray running inside a face between two cells (d = 0 on that
+ *   axis) walks the cells on the upper side of it; both closed cells bound the density there.
+ * - parts of [t0, t1] outside the box belong to the nearest boundary cell (density is 0 there,
+ *   so that stays conservative); callers clip to the box first (medium_intersect) to avoid waste.
+ * - at most cells_x + cells_y + cells_z - 2 segments (each step advances one axis monotonically
+ *   within its range); the loop is also capped at cells_x + cells_y + cells_z + 3 iterations, and
+ *   next() returning 0 with it.t < it.t_end would mean that cap was hit (it cannot be by
+ *   construction; a kernel may flag STATUS_ITERATION_CAP on it).
+ * - a zero or negative-zero direction component never steps on that axis; a start point exactly
+ *   on a cell boundary starts in the cell the ray enters (the lower one when d < 0). A
+ *   non-finite o or d yields nothing.
+ * Float rounding can place a point the DDA attributes to a cell up to a few ulps of its index
+ * coordinates outside that cell; the host build pads every cell by MAJORANT_SLACK index units so
+ * the bound holds there too. */
+#ifndef NARVAL_MAJORANT_H
+#define NARVAL_MAJORANT_H
+
+#include "shared/vec3.h"
+
+/* Relative safety factor on σ̄ = σt_max · cell value: float rounding in the trilinear lerps can
+ * exceed the largest corner by a few ulps (the same factor as the global majorant in
+ * scene_upload.cpp), so that 1 - σt/σ̄ never goes negative. */
+#define MAJORANT_MARGIN (1.0f + 1e-5f)
+/* Index units by which the host pads each cell when bounding it (see the note above). */
+#define MAJORANT_SLACK (1.0f / 256.0f)
+
+/* Crosses host and device: declared once, 4-byte fields padded to a multiple of 16 bytes (32 bytes:
+ * cell_size at 0, cells_x/y/z at 16/20/24, pad0 at 28), the same layout in C++ and OpenCL C. */
+typedef struct majorant_grid_params {
+  nv_float4 cell_size; /* xyz: index units per cell along each axis (dims / cells); w unused */
+  int cells_x;
+  int cells_y;
+  int cells_z;
+  int pad0;
+} majorant_grid_params;
+
+/* Private DDA state; fields are read by tests, kernels only call begin/next. */
+typedef struct majorant_iter {
+  vec3 o, inv_d;           /* index-space ray origin and 1/d (unused on axes with d == 0) */
+  float t, t_end;          /* start of the next segment; end of the whole segment */
+  float next_x, next_y, next_z; /* t at which the ray leaves the current cell along each axis
+                                   (NV_INFINITY: it never does inside the grid) */
+  float size_x, size_y, size_z; /* cell size */
+  int cx, cy, cz;          /* current cell */
+  int step_x, step_y, step_z; /* +1, -1, or 0 (no movement along the axis) */
+  int nx, ny, nz;          /* cell counts */
+  int budget;              /* loop iterations left (cells_x + cells_y + cells_z + 3) */
+  int seg_cell;            /* linear index of the cell of the last yielded segment */
+} majorant_iter;
+
+/* The cell of coordinate p along one axis, clamped to [0, n-1]: the c with c·size <= p <
+ * (c+1)·size, faces formed as the DDA steps on them (float products), so the quotient's rounding is
+ * settled against them. A coordinate exactly on a face belongs to the cell the ray enters: the
+ * upper one for dir >= 0 (also dir == 0: a ray inside a face walks the upper cells), the lower one
+ * for dir < 0. fmin/fmax send NaN to 0, so the int is defined. */
+static inline int majorant_cell_of(float p, float size, float dir, int n) {
+  float c = nv_floor(p / size);
+  if ((c + 1.0f) * size <= p)
+    c += 1.0f;
+  else if (c * size > p)
+    c -= 1.0f;
+  if (dir < 0.0f && c * size == p) c -= 1.0f;
+  return (int)nv_fmin(nv_fmax(c, 0.0f), (float)(n - 1));
+}
+
+/* The t at which the ray leaves cell c along one axis: the far boundary in the direction of
+ * travel, or NV_INFINITY when the axis does not move or c is the last cell that way (the ray then
+ * stays in that boundary cell, see the contract). */
+static inline float majorant_exit_t(int c, int step, int n, float size, float o, float inv_d) {
+  if (step > 0) return c + 1 < n ? ((float)(c + 1) * size - o) * inv_d : NV_INFINITY;
+  if (step < 0) return c > 0 ? ((float)c * size - o) * inv_d : NV_INFINITY;
+  return NV_INFINITY;
+}
+
+/* The cell the walk starts in along one axis: the position's cell, then settled against the DDA's
+ * own crossing times (the expressions majorant_exit_t uses), so that the first exit lies after t0
+ * and the cell entered before it. The position o + t0·d carries a rounding error of an ulp of
+ * |o| + |t0·d|; on a ray nearly parallel to a face that is a long stretch of t, which the spatial
+ * test alone would attribute to the wrong side. One step either way suffices: the error is ulps of
+ * the coordinates, far below a cell's width (at least a voxel with chooseMajorantResolution). */
+static inline int majorant_start_cell(float o, float d, float inv_d, float t0, float size, int n) {
+  int c = majorant_cell_of(o + d * t0, size, d, n);
+  if (d > 0.0f) {
+    if (c + 1 < n && ((float)(c + 1) * size - o) * inv_d <= t0)
+      c += 1; /* its exit is already behind */
+    else if (c > 0 && ((float)c * size - o) * inv_d > t0)
+      c -= 1; /* not entered yet */
+  } else if (d < 0.0f) {
+    if (c > 0 && ((float)c * size - o) * inv_d <= t0)
+      c -= 1;
+    else if (c + 1 < n && ((float)(c + 1) * size - o) * inv_d > t0)
+      c += 1;
+  }
+  return c;
+}
+
+static inline majorant_iter majorant_iter_begin(majorant_grid_params g, vec3 o, vec3 d, float t0, float t1) {
+  majorant_iter it;
+  it.o = o;
+  it.inv_d = vec3_make(d.x != 0.0f ? 1.0f / d.x : 0.0f, d.y != 0.0f ? 1.0f / d.y : 0.0f,
+                       d.z != 0.0f ? 1.0f / d.z : 0.0f);
+  it.t = t0;
+  it.t_end = t1;
+  it.size_x = g.cell_size.x;
+  it.size_y = g.cell_size.y;
+  it.size_z = g.cell_size.z;
+  it.nx = g.cells_x;
+  it.ny = g.cells_y;
+  it.nz = g.cells_z;
+  it.step_x = d.x > 0.0f ? 1 : (d.x < 0.0f ? -1 : 0);
+  it.step_y = d.y > 0.0f ? 1 : (d.y < 0.0f ? -1 : 0);
+  it.step_z = d.z > 0.0f ? 1 : (d.z < 0.0f ? -1 : 0);
+  it.budget = g.cells_x + g.cells_y + g.cells_z + 3;
+  it.seg_cell = -1;
+  if (!(nv_isfinite(t0) && nv_isfinite(t1) && vec3_is_finite(o) && vec3_is_finite(d)) || g.cells_x < 1 ||
+      g.cells_y < 1 || g.cells_z < 1) {
+    it.budget = 0; /* nothing to walk */
+    it.t_end = it.t;
+  }
+  it.cx = majorant_start_cell(o.x, d.x, it.inv_d.x, t0, it.size_x, it.nx);
+  it.cy = majorant_start_cell(o.y, d.y, it.inv_d.y, t0, it.size_y, it.ny);
+  it.cz = majorant_start_cell(o.z, d.z, it.inv_d.z, t0, it.size_z, it.nz);
+  it.next_x = majorant_exit_t(it.cx, it.step_x, it.nx, it.size_x, o.x, it.inv_d.x);
+  it.next_y = majorant_exit_t(it.cy, it.step_y, it.ny, it.size_y, o.y, it.inv_d.y);
+  it.next_z = majorant_exit_t(it.cz, it.step_z, it.nz, it.size_z, o.z, it.inv_d.z);
+  return it;
+}
+
+/* Yields the next segment and its cell's value; 0 when [t0, t1] is covered. */
+static inline int majorant_iter_next(NV_PRIVATE majorant_iter* it, NV_GLOBAL const float* cell_max,
+                                     NV_PRIVATE float* seg_t0, NV_PRIVATE float* seg_t1,
+                                     NV_PRIVATE float* seg_max) {
+  while (it->budget > 0) {
+    it->budget -= 1;
+    if (!(it->t < it->t_end)) return 0;
+    const float t_exit = nv_fmin(it->next_x, nv_fmin(it->next_y, it->next_z));
+    const float start = it->t;
+    const float end = nv_fmin(t_exit, it->t_end);
+    const int cell = it->cx + it->nx * (it->cy + it->ny * it->cz);
+    if (!(t_exit < it->t_end)) { /* also a NaN exit (0·inf for a denormal d): stay in this cell */
+      it->t = it->t_end;
+    } else {
+      /* Step every axis whose boundary lies at t_exit (an edge or corner crossed exactly moves
+       * diagonally, never through a cell the ray only touches); t_exit < t_end makes it a number
+       * equal to at least one of them. A crossing behind `start` (float rounding at the start
+       * point) steps without moving t. */
+      it->t = nv_fmax(start, t_exit);
+      if (it->next_x == t_exit) {
+        it->cx += it->step_x;
+        it->next_x = majorant_exit_t(it->cx, it->step_x, it->nx, it->size_x, it->o.x, it->inv_d.x);
+      }
+      if (it->next_y == t_exit) {
+        it->cy += it->step_y;
+        it->next_y = majorant_exit_t(it->cy, it->step_y, it->ny, it->size_y, it->o.y, it->inv_d.y);
+      }
+      if (it->next_z == t_exit) {
+        it->cz += it->step_z;
+        it->next_z = majorant_exit_t(it->cz, it->step_z, it->nz, it->size_z, it->o.z, it->inv_d.z);
+      }
+    }
+    if (end > start) {
+      *seg_t0 = start;
+      *seg_t1 = end;
+      *seg_max = cell_max[cell];
+      it->seg_cell = cell;
+      return 1;
+    }
+    /* Zero or negative length (rounding at the start point): the ray does not really pass
+     * through this cell; go on to the next one. */
+  }
+  return 0;
+}
+
+#endif
