@@ -44,9 +44,10 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   rt.queue.enqueueFillBuffer(compBuf, 0.0f, 0, pixels * 4 * sizeof(float));
   rt.queue.enqueueFillBuffer(statusBuf, cl_uint(0), 0, sizeof(cl_uint));
   dev.bind(kernel);
-  kernel.setArg(3, sumBuf);
-  kernel.setArg(4, compBuf);
-  kernel.setArg(7, statusBuf);
+  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
+  kernel.setArg(arg + 0, sumBuf);
+  kernel.setArg(arg + 1, compBuf);
+  kernel.setArg(arg + 4, statusBuf);
   rt.queue.finish();
   st.buildSeconds = secondsSince(t0);
 
@@ -56,8 +57,8 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   const auto tLoop = std::chrono::steady_clock::now();
   for (int done = 0; done < spp;) {
     const int count = std::min(perPass, spp - done);
-    kernel.setArg(5, cl_uint(done));
-    kernel.setArg(6, cl_uint(count));
+    kernel.setArg(arg + 2, cl_uint(done));
+    kernel.setArg(arg + 3, cl_uint(count));
     const auto tPass = std::chrono::steady_clock::now();
     cl::Event ev;
     rt.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &ev);

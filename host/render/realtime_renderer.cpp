@@ -57,10 +57,11 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
   rt.queue.enqueueFillBuffer(statusBuf, cl_uint(0), 0, sizeof(cl_uint));
   dev.bind(kernel);
-  kernel.setArg(3, paramBuf);
-  kernel.setArg(4, dirBuf);
-  kernel.setArg(5, outBuf);
-  kernel.setArg(6, statusBuf);
+  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
+  kernel.setArg(arg + 0, paramBuf);
+  kernel.setArg(arg + 1, dirBuf);
+  kernel.setArg(arg + 2, outBuf);
+  kernel.setArg(arg + 3, statusBuf);
   rt.queue.finish();
   st.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 

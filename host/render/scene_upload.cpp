@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "scene/input_error.h"
+#include "volume/majorant_grid.h"
 
 namespace narval {
 namespace {
@@ -205,6 +206,18 @@ DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
       throw inputError(scene.sourcePath, key, "the volume's transform is singular (a zero scale?)");
     }
     ds.grid = grid;
+    if (grid) {
+      const std::array<int, 3> cells = chooseMajorantResolution(grid->nx, grid->ny, grid->nz);
+      const MajorantGrid mg = buildMajorantGrid(*grid, cells[0], cells[1], cells[2]);
+      med.majorant_grid = mg.params();
+      ds.majorants = mg.maxDensity;
+    }
+  }
+  if (ds.majorants.empty()) {
+    // One cell over the whole box: density 1 (homogeneous) or 0 (no medium).
+    sp.medium.majorant_grid.cell_size = sp.medium.dims;
+    sp.medium.majorant_grid.cells_x = sp.medium.majorant_grid.cells_y = sp.medium.majorant_grid.cells_z = 1;
+    ds.majorants.assign(1, sp.has_medium ? 1.0f : 0.0f);
   }
   sp.num_lights = int(ds.lights.size());
   if (ds.lights.empty()) ds.lights.push_back(light_params{});  // a buffer may not be empty

@@ -15,6 +15,9 @@ struct DeviceScene {
   scene_params params{};
   std::vector<light_params> lights;
   const DenseGrid* grid = nullptr;  // null: homogeneous medium or none
+  // Per-cell density bounds of the majorant grid (medium.majorant_grid): one cell of 1 for a
+  // homogeneous medium, one cell of 0 without a medium.
+  std::vector<float> majorants;
   std::string buildOptions;         // -D defines for this scene
   std::vector<std::string> warnings;
 };

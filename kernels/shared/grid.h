@@ -2,7 +2,9 @@
  * with p in grid index space (voxel i covers [i, i+1], centre i + 0.5; trilinear; 0 outside).
  * Device: a 3D image (CL_R, CL_FLOAT) read with the hardware sampler, or 1 everywhere for a
  * homogeneous medium (-D MEDIUM_HOMOGENEOUS). Host: the same reconstruction on a float array, so
- * tests and a native baseline see the same field. Storage is chosen here and nowhere else. */
+ * tests and a native baseline see the same field. Storage is chosen here and nowhere else.
+ * GRID_PARAM also carries the majorant grid's per-cell bounds (GRID_MAJORANTS), so every function
+ * that reads density can skip empty space (march.h) without another parameter. */
 #ifndef NARVAL_GRID_H
 #define NARVAL_GRID_H
 
@@ -11,15 +13,17 @@
 #ifdef NV_DEVICE
 
 #ifdef MEDIUM_HOMOGENEOUS
-#define GRID_PARAM int grid_unused
-#define GRID_ARG grid_unused
-#define GRID_KERNEL_PARAM int grid_unused
+#define GRID_PARAM int grid_unused, NV_GLOBAL const float* grid_majorants
+#define GRID_ARG grid_unused, grid_majorants
+#define GRID_KERNEL_PARAM GRID_PARAM
+#define GRID_MAJORANTS grid_majorants
 #define GRID_IS_HOMOGENEOUS(g) 1
 static inline float grid_density(GRID_PARAM, vec3 p) { return 1.0f; }
 #else
-#define GRID_PARAM read_only image3d_t grid
-#define GRID_ARG grid
-#define GRID_KERNEL_PARAM read_only image3d_t grid
+#define GRID_PARAM read_only image3d_t grid, NV_GLOBAL const float* grid_majorants
+#define GRID_ARG grid, grid_majorants
+#define GRID_KERNEL_PARAM GRID_PARAM
+#define GRID_MAJORANTS grid_majorants
 #define GRID_IS_HOMOGENEOUS(g) 0
 __constant sampler_t grid_sampler = CLK_NORMALIZED_COORDS_FALSE | CLK_ADDRESS_CLAMP | CLK_FILTER_LINEAR;
 static inline float grid_density(GRID_PARAM, vec3 p) {
@@ -34,9 +38,11 @@ static inline float grid_density(GRID_PARAM, vec3 p) {
 typedef struct grid_view {
   const float* data; /* NULL: homogeneous, density 1 */
   int nx, ny, nz;
+  const float* majorants; /* per-cell density bounds (medium_params.majorant_grid); NULL: no skipping */
 } grid_view;
 #define GRID_PARAM const grid_view* grid
 #define GRID_ARG grid
+#define GRID_MAJORANTS (grid->majorants)
 #define GRID_IS_HOMOGENEOUS(g) ((g)->data == 0)
 
 static inline float grid_voxel(const grid_view* g, int x, int y, int z) {

@@ -13,8 +13,9 @@
  *   lobe_points   n, the directions in `dirs` (default 30)
  *
  * 1. x0: the first point of the view ray inside the box where the density is above zero. The
- *    search samples t0 + j·Δ, j = 0..steps, Δ = (t1 − t0)/steps, and bisects the step where the
- *    density first becomes positive; features thinner than Δ between two samples can be missed.
+ *    search takes `steps` midpoint samples over the occupied majorant cells only (march_iter) and
+ *    bisects the step where the density first becomes positive; features thinner than a step
+ *    between two samples can be missed.
  * 2. c = x0 + t·ω, t = depth_factor / σ̄t, σ̄t the mean over channels of (σa + σs) for unit density
  *    (D included). Clamp: t never exceeds the rest of the view ray's segment inside the box, so c
  *    stays "a point inside the volume" as ch. 6 describes it (the box is the medium's support; past
@@ -60,20 +61,25 @@ static inline vec3 lobe_view_dir(NV_CONSTANT const camera_params* c, float px, f
   return vec3_normalize(vec3_add(fwd, vec3_add(vec3_scale(right, sx), vec3_scale(up, sy))));
 }
 
-/* First parameter in [seg.t0, seg.t1] where the density is above zero; 0 when there is none. */
-static inline int lobe_first_hit(GRID_PARAM, NV_PRIVATE const medium_segment* seg, int steps,
-                                 NV_PRIVATE float* t_hit) {
-  const int n = steps > 0 ? steps : 1;
-  const float dt = (seg->t1 - seg->t0) / (float)n;
-  for (int j = 0; j <= n; ++j) {
-    const float t = j == n ? seg->t1 : seg->t0 + (float)j * dt;
-    if (!(grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t)) > 0.0f)) continue;
-    if (j == 0) {
-      *t_hit = t;
+/* First parameter in [seg.t0, seg.t1] where the density is above zero; 0 when there is none. The
+ * search samples the occupied cells only (march_iter), then bisects between the last empty sample
+ * (or the start of the occupied piece) and the first non-empty one. */
+static inline int lobe_first_hit(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_PRIVATE const medium_segment* seg,
+                                 int steps, NV_PRIVATE float* t_hit) {
+  march_iter it = march_begin(m, GRID_ARG, seg, steps);
+  float t, lo = seg->t0;
+  while (march_next(&it, GRID_ARG, &t)) {
+    if (!(grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t)) > 0.0f)) {
+      lo = t;
+      continue;
+    }
+    lo = nv_fmax(lo, it.a); /* before its occupied piece the density is 0 */
+    if (grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, lo)) > 0.0f) {
+      *t_hit = lo;
       return 1;
     }
     /* Invariant: density(lo) == 0 < density(hi). */
-    float lo = seg->t0 + (float)(j - 1) * dt, hi = t;
+    float hi = t;
     for (int b = 0; b < LOBE_BISECTIONS; ++b) {
       const float mid = 0.5f * (lo + hi);
       if (grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, mid)) > 0.0f)
@@ -114,7 +120,7 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
 
   /* 1. First hit. */
   float t_x0;
-  if (!lobe_first_hit(GRID_ARG, &seg, p->steps, &t_x0)) return Lb;
+  if (!lobe_first_hit(m, GRID_ARG, &seg, p->steps, &t_x0)) return Lb;
   const vec3 x0 = vec3_madd(origin, dir, t_x0);
 
   /* 2. Lobe centre, depth clamped to the rest of the segment inside the box. */

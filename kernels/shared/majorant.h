@@ -37,7 +37,7 @@
 #ifndef NARVAL_MAJORANT_H
 #define NARVAL_MAJORANT_H
 
-#include "shared/vec3.h"
+#include "shared/structs.h"
 
 /* Relative safety factor on σ̄ = σt_max · cell value: float rounding in the trilinear lerps can
  * exceed the largest corner by a few ulps (the same factor as the global majorant in
@@ -46,15 +46,6 @@
 /* Index units by which the host pads each cell when bounding it (see the note above). */
 #define MAJORANT_SLACK (1.0f / 256.0f)
 
-/* Crosses host and device: declared once, 4-byte fields padded to a multiple of 16 bytes (32 bytes:
- * cell_size at 0, cells_x/y/z at 16/20/24, pad0 at 28), the same layout in C++ and OpenCL C. */
-typedef struct majorant_grid_params {
-  nv_float4 cell_size; /* xyz: index units per cell along each axis (dims / cells); w unused */
-  int cells_x;
-  int cells_y;
-  int cells_z;
-  int pad0;
-} majorant_grid_params;
 
 /* Private DDA state; fields are read by tests, kernels only call begin/next. */
 typedef struct majorant_iter {

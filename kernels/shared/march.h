@@ -2,11 +2,15 @@
  * Transmittance by midpoint sampling with true step lengths, all three channels (DESIGN.md:
  * "every step uses its true length"), and lights as points: a rectangle becomes a point at its
  * centre with intensity Le·A·max(0, cos θ_light), the approximation DESIGN.md allows for these
- * kernels (the path tracer always integrates the true area light). */
+ * kernels (the path tracer always integrates the true area light).
+ * Empty space: a march places its samples only in majorant cells whose density bound is above 0
+ * (majorant.h DDA), spread evenly over their total length, so time follows the medium, not the box;
+ * the skipped cells have density exactly 0 there, so skipping them changes nothing but the spacing. */
 #ifndef NARVAL_MARCH_H
 #define NARVAL_MARCH_H
 
 #include "shared/grid.h"
+#include "shared/majorant.h"
 #include "shared/medium.h"
 
 /* σt at world point o + t·d of a medium segment (index-space origin and direction in `seg`). */
@@ -16,18 +20,81 @@ static inline vec3 march_sigma_t(NV_CONSTANT const medium_params* m, GRID_PARAM,
   return vec3_scale(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)), rho);
 }
 
-/* Optical depth τ from `origin` over `dist` along unit `dir`: `steps` equal steps over the part of
- * the segment inside the box, σt sampled at each step's midpoint, Σ σt·Δ. 0 outside the box. The
- * ray marcher's octaves need τ itself (exp(−bⁱτ)), which survives where exp(−τ) underflows. */
+/* Midpoint samples over the occupied part of a segment: `steps` samples at compressed positions
+ * (k + 0.5)·Δ, Δ = occupied length / steps, mapped back to t through the occupied cells in order.
+ * With one cell (a homogeneous medium) this is exactly t0 + (k + 0.5)·(t1 − t0)/steps. */
+typedef struct march_iter {
+  majorant_iter dda;
+  float a, b;     /* current occupied piece [a, b] */
+  float s_a;      /* compressed position of a */
+  float delta;    /* step length, world units */
+  int k, steps;
+  int whole;      /* no majorant grid (host without bounds): the segment is one piece */
+} march_iter;
+
+/* Next occupied piece of the walk into [*a, *b]; 0 when none is left. */
+static inline int march_next_piece(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRIVATE float* a, NV_PRIVATE float* b) {
+  float mx;
+  if (it->whole) {
+    if (!(it->dda.t < it->dda.t_end)) return 0;
+    *a = it->dda.t;
+    *b = it->dda.t_end;
+    it->dda.t = it->dda.t_end;
+    return 1;
+  }
+  while (majorant_iter_next(&it->dda, GRID_MAJORANTS, a, b, &mx))
+    if (mx > 0.0f) return 1;
+  return 0;
+}
+
+static inline march_iter march_begin(NV_CONSTANT const medium_params* m, GRID_PARAM,
+                                     NV_PRIVATE const medium_segment* seg, int steps) {
+  march_iter it;
+  it.whole = GRID_MAJORANTS == 0;
+  it.dda = majorant_iter_begin(m->majorant_grid, seg->o, seg->d, seg->t0, seg->t1);
+  if (it.whole) {
+    it.dda.t = seg->t0;
+    it.dda.t_end = seg->t1;
+  }
+  /* First walk: the occupied length. */
+  march_iter probe = it;
+  float a, b, len = 0.0f;
+  while (march_next_piece(&probe, GRID_ARG, &a, &b)) len += b - a;
+  it.a = it.b = it.s_a = 0.0f;
+  it.steps = steps > 0 ? steps : 1;
+  it.delta = len / (float)it.steps;
+  it.k = 0;
+  return it;
+}
+
+/* The next sample's t (each sample stands for it->delta of path); 0 when all are placed. */
+static inline int march_next(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRIVATE float* t) {
+  if (it->k >= it->steps || !(it->delta > 0.0f)) return 0;
+  const float s = ((float)it->k + 0.5f) * it->delta;
+  while (!(s < it->s_a + (it->b - it->a))) {
+    float a, b;
+    it->s_a += it->b - it->a;
+    if (!march_next_piece(it, GRID_ARG, &a, &b)) return 0;
+    it->a = a;
+    it->b = b;
+  }
+  *t = it->a + (s - it->s_a);
+  it->k += 1;
+  return 1;
+}
+
+/* Optical depth τ from `origin` over `dist` along unit `dir`: `steps` midpoint samples over the
+ * occupied part of the segment inside the box, Σ σt·Δ. 0 outside the box. The ray marcher's
+ * octaves need τ itself (exp(−bⁱτ)), which survives where exp(−τ) underflows. */
 static inline vec3 march_optical_depth(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
                                        float dist, int steps) {
   medium_segment seg;
   if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) return vec3_splat(0.0f);
-  const float dt = (seg.t1 - seg.t0) / (float)steps;
+  march_iter it = march_begin(m, GRID_ARG, &seg, steps);
   vec3 tau = vec3_splat(0.0f);
-  for (int i = 0; i < steps; ++i)
-    tau = vec3_add(tau, march_sigma_t(m, GRID_ARG, &seg, seg.t0 + ((float)i + 0.5f) * dt));
-  return vec3_scale(tau, dt);
+  float t;
+  while (march_next(&it, GRID_ARG, &t)) tau = vec3_add(tau, march_sigma_t(m, GRID_ARG, &seg, t));
+  return vec3_scale(tau, it.delta);
 }
 
 /* Transmittance exp(−τ) over the same quadrature (1 outside the box). */

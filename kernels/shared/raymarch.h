@@ -7,7 +7,7 @@
  * Parameters (realtime_params):
  * | field        | meaning                                                                  |
  * |--------------|--------------------------------------------------------------------------|
- * | steps        | samples over the view ray's segment inside the box, each of true length   |
+ * | steps        | samples over the occupied part of the view ray's box segment, true length  |
  * | shadow_steps | samples per shadow ray, clipped to the box                                |
  * | octaves      | N; 1 = plain single scattering                                            |
  * | octave_a/b/c | per-octave scale of σs, of the shadow ray's σt, of the HG g               |
@@ -38,10 +38,9 @@
  * U the same march with the phase function and the shadow transmittance replaced by 1: bounded
  * whenever a < 1. (a ≤ b keeps each octave's effective albedo σs·aⁱ/(σt·bⁱ) ≤ σs/σt.)
  *
- * Empty space: the march is written per interval (raymarch_interval marches [t0, t1] with a given
- * number of steps), so a majorant/occupancy grid can later skip empty intervals and march only the
- * occupied ones; for now the whole box segment is one interval. Samples of zero density change
- * nothing (S = 0, e^{−0} = 1) and skip the light loop. */
+ * Empty space: the `steps` samples are spread over the occupied majorant cells only (march_iter in
+ * march.h), so empty parts of the box cost nothing and the step is shorter where there is medium.
+ * Samples of zero density change nothing (S = 0, e^{−0} = 1) and skip the light loop. */
 #ifndef NARVAL_RAYMARCH_H
 #define NARVAL_RAYMARCH_H
 
@@ -96,17 +95,19 @@ typedef struct raymarch_accum {
   vec3 L, T;
 } raymarch_accum;
 
-/* Marches [t0, t1] of the view ray origin + t·dir (its box segment `seg`, for index-space
- * lookups) in `steps` steps of true length (t1 − t0)/steps, sampled at their midpoints. */
-static inline void raymarch_interval(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                     GRID_PARAM, NV_CONSTANT const realtime_params* rp,
-                                     NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, float t0, float t1,
-                                     int steps, NV_PRIVATE raymarch_accum* acc) {
+/* Marches the view ray origin + t·dir over its box segment `seg` in `steps` steps of equal true
+ * length spread over the occupied cells (march_iter: empty cells are skipped), sampled at their
+ * midpoints. */
+static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                    GRID_PARAM, NV_CONSTANT const realtime_params* rp,
+                                    NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, int steps,
+                                    NV_PRIVATE raymarch_accum* acc) {
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
-  const float dt = (t1 - t0) / (float)steps;
-  for (int k = 0; k < steps; ++k) {
-    const float t = t0 + ((float)k + 0.5f) * dt;
+  march_iter it = march_begin(m, GRID_ARG, seg, steps);
+  const float dt = it.delta;
+  float t;
+  while (march_next(&it, GRID_ARG, &t)) {
     const float rho = grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t));
     if (!(rho > 0.0f)) continue; /* S = 0 and e^{−0} = 1: the step would change nothing */
     const vec3 sigma_t = vec3_scale(vec3_add(sa, ss), rho); /* as march_sigma_t */
@@ -140,7 +141,7 @@ static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT
       raymarch_accum acc;
       acc.L = vec3_splat(0.0f);
       acc.T = vec3_splat(1.0f);
-      raymarch_interval(s, lights, GRID_ARG, rp, &seg, r.origin, r.dir, seg.t0, seg.t1, rp->steps, &acc);
+      raymarch_segment(s, lights, GRID_ARG, rp, &seg, r.origin, r.dir, rp->steps, &acc);
       L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
     }
   }

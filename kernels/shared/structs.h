@@ -50,6 +50,17 @@ typedef struct light_params {
   int pad2;
 } light_params;
 
+/* The coarse majorant grid over the medium's index box (host/volume/majorant_grid.h): cells of
+ * cell_size index units; the per-cell density bounds travel in their own buffer. Walked by the DDA
+ * in majorant.h. */
+typedef struct majorant_grid_params {
+  nv_float4 cell_size; /* xyz: index units per cell along each axis (dims / cells); w unused */
+  int cells_x;
+  int cells_y;
+  int cells_z;
+  int pad0;
+} majorant_grid_params;
+
 /* The participating medium: an axis-aligned box [0, dims] in grid index space (voxel i covers
  * [i, i+1], its centre at i + 0.5), reached from world space through one affine map. Coefficients
  * are per unit density and already include the material's density multiplier D. */
@@ -62,6 +73,7 @@ typedef struct medium_params {
   float g;              /* Henyey-Greenstein asymmetry */
   int phase;            /* PHASE_ISOTROPIC or PHASE_HG */
   int grey;             /* 1: sigma_a and sigma_s are equal in all channels (analogue tracking) */
+  majorant_grid_params majorant_grid; /* density bounds per cell: empty space is skipped */
 } medium_params;
 
 /* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */

@@ -60,13 +60,17 @@ TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepth) {
   cl_uint zero = 0;
   cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof(cl_uint), &zero);
   cl::Image3D image = uploadGrid(rt, cloud);
+  // Ratio tracking against the global majorant reads no majorant cells: a one-cell stand-in.
+  cl::Buffer cellsBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(float),
+                      const_cast<float*>(&cloud.maxValue));
   k.setArg(0, mBuf);
   k.setArg(1, image);
-  k.setArg(2, rayBuf);
-  k.setArg(3, n);
-  k.setArg(4, meanBuf);
-  k.setArg(5, varBuf);
-  k.setArg(6, statusBuf);
+  k.setArg(2, cellsBuf);
+  k.setArg(3, rayBuf);
+  k.setArg(4, n);
+  k.setArg(5, meanBuf);
+  k.setArg(6, varBuf);
+  k.setArg(7, statusBuf);
   rt.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(numRays), cl::NullRange);
   std::vector<float> mean(numRays), var(numRays);
   cl_uint status = 0;

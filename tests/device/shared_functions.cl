@@ -94,7 +94,7 @@ __kernel void sf_tracking_ratio(__constant medium_params* m, __global const floa
   if (i >= n) return;
   rng_state rng = rng_init(1u, i, 0u);
   uint status = 0u;
-  const vec3 tr = tracking_ratio(m, 0, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), in[2 * i], in[2 * i + 1], &rng, &status);
+  const vec3 tr = tracking_ratio(m, 0, 0, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), in[2 * i], in[2 * i + 1], &rng, &status);
   out[3 * i + 0] = tr.x;
   out[3 * i + 1] = tr.y;
   out[3 * i + 2] = tr.z;
@@ -110,7 +110,7 @@ __kernel void sf_tracking_delta(__constant medium_params* m, __global const floa
   uint status = 0u;
   vec3 beta = vec3_make(1.0f, 1.0f, 1.0f);
   float t = -1.0f;
-  const int e = tracking_delta(m, 0, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), 0.0f, in[i], &rng, &beta,
+  const int e = tracking_delta(m, 0, 0, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), 0.0f, in[i], &rng, &beta,
                                &t, &status);
   out[5 * i + 0] = (float)e;
   out[5 * i + 1] = t;

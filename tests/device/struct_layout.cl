@@ -24,6 +24,9 @@
   S(medium_params) F(medium_params, world_to_index) F(medium_params, world_to_index.row[2])        \
   F(medium_params, dims) F(medium_params, sigma_a) F(medium_params, sigma_s)                       \
   F(medium_params, majorant) F(medium_params, g) F(medium_params, phase) F(medium_params, grey)    \
+  F(medium_params, majorant_grid) F(medium_params, majorant_grid.cells_z)                         \
+  S(majorant_grid_params) F(majorant_grid_params, cell_size) F(majorant_grid_params, cells_x)     \
+  F(majorant_grid_params, cells_y) F(majorant_grid_params, cells_z) F(majorant_grid_params, pad0)  \
   S(scene_params) F(scene_params, camera) F(scene_params, camera.height) F(scene_params, medium)    \
   F(scene_params, medium.sigma_s) F(scene_params, medium.grey) F(scene_params, background)         \
   F(scene_params, has_medium) F(scene_params, num_lights) F(scene_params, max_bounces)             \
