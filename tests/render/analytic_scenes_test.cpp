@@ -20,36 +20,15 @@ namespace {
 // (analogue delta tracking absorbs or passes), variance T(1-T) ≈ 0.25: 256 px × 2560 spp give a
 // relative standard error of 0.125%, so 0.5% is a 4σ bound (false failure rate ~6e-5).
 TEST(RenderAnalytic, AbsorptionOnlyBoxMatchesBeerLambert) {
-  Scene scene = sceneFromJson(R"({
-    "materials": [
-      {"name": "light", "type": "emitter", "albedo": [2, 3, 4]},
-      {"name": "absorber", "type": "volume", "scattering": [0, 0, 0], "absorption": [0.7, 0.7, 0.7],
-       "phaseFunction": "isotropic", "density": 1}
-    ],
-    "primitives": [
-      {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 5], "scale": [40, 40, 1]},
-       "materialName": "light"},
-      {"name": "box", "type": "volume", "transform": {"position": [0, 0, 0], "scale": [2, 2, 1]},
-       "materialName": "absorber"}
-    ],
-    "camera": {"position": [0, 0, -10], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 2},
-    "renderer": {"resolution": [16, 16], "spp": 2560, "bounces": 3}
-  })");
+  const Scene scene = sceneFromJson(absorptionBoxJson(R"({"resolution": [16, 16], "spp": 2560, "bounces": 3})"));
   const RenderResult r = render(scene);
-  const DeviceScene ds = buildDeviceScene(scene, nullptr);
+  const camera_params c = buildDeviceScene(scene, nullptr).params.camera;
   double expected = 0;
   for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 16; ++x) {
-      const camera_params& c = ds.params.camera;
-      const float sx = (2.0f * (x + 0.5f) / 16 - 1) * c.tan_half_vfov * c.aspect;
-      const float sy = (1 - 2.0f * (y + 0.5f) / 16) * c.tan_half_vfov;
-      const double cosTheta = 1.0 / std::sqrt(1.0 + double(sx) * sx + double(sy) * sy);
-      expected += std::exp(-0.7 / cosTheta) / 256.0;
-    }
-  const double le[3] = {2, 3, 4};
+    for (int x = 0; x < 16; ++x) expected += absorptionBoxTransmittance(c, x, y) / 256.0;
   for (int ch = 0; ch < 3; ++ch) {
     const ChannelStats s = channelStats(r.image, ch);
-    EXPECT_NEAR(s.mean / le[ch], expected, 0.005 * expected) << "channel " << ch;
+    EXPECT_NEAR(s.mean / kAbsorptionBoxLe[ch], expected, 0.005 * expected) << "channel " << ch;
   }
   EXPECT_EQ(r.stats.status, 0u);
   EXPECT_EQ(r.stats.nanPixels, 0);

@@ -497,31 +497,17 @@ namespace {
 // Le · exp(−σt·d) with d = 1/cos θ the path through the unit-thick box: Beer-Lambert, which the
 // midpoint rule gets exactly for a constant σt (up to float rounding).
 TEST(RenderLobe, AbsorptionOnlyIsBeerLambert) {
-  Scene scene = sceneFromJson(R"({
-    "materials": [
-      {"name": "light", "type": "emitter", "albedo": [2, 3, 4]},
-      {"name": "absorber", "type": "volume", "scattering": [0, 0, 0], "absorption": [0.7, 0.7, 0.7],
-       "phaseFunction": "isotropic", "density": 1}
-    ],
-    "primitives": [
-      {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 5], "scale": [40, 40, 1]},
-       "materialName": "light"},
-      {"name": "box", "type": "volume", "transform": {"scale": [2, 2, 1]}, "materialName": "absorber"}
-    ],
-    "camera": {"position": [0, 0, -10], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 2},
-    "renderer": {"resolution": [8, 8], "lobe": {"depthFactor": 1000, "lobeRadius": 0}}
-  })");
+  const Scene scene =
+      sceneFromJson(absorptionBoxJson(R"({"resolution": [8, 8], "lobe": {"depthFactor": 1000, "lobeRadius": 0}})"));
   const RenderResult r = renderLobe(scene);
   const camera_params c = buildDeviceScene(scene, nullptr).params.camera;
-  const double le[3] = {2, 3, 4};
   for (int y = 0; y < 8; ++y)
-    for (int x = 0; x < 8; ++x) {
-      const double sx = (2.0 * (x + 0.5) / 8 - 1) * c.tan_half_vfov * c.aspect, sy = (1 - 2.0 * (y + 0.5) / 8) * c.tan_half_vfov;
-      const double d = std::sqrt(1.0 + sx * sx + sy * sy);  // 1 / cos θ
-      for (int ch = 0; ch < 3; ++ch)
-        EXPECT_NEAR(r.image.rgb[size_t((y * 8 + x) * 3 + ch)], le[ch] * std::exp(-0.7 * d), 0.01 * le[ch] * std::exp(-0.7 * d))
+    for (int x = 0; x < 8; ++x)
+      for (int ch = 0; ch < 3; ++ch) {
+        const double expected = kAbsorptionBoxLe[ch] * absorptionBoxTransmittance(c, x, y);
+        EXPECT_NEAR(r.image.rgb[size_t((y * 8 + x) * 3 + ch)], expected, 0.01 * expected)
             << "pixel " << x << "," << y << " channel " << ch;
-    }
+      }
 }
 
 }  // namespace

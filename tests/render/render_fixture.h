@@ -9,6 +9,7 @@
 
 #include "cl/cl_runtime.h"
 #include "render/pathtrace_renderer.h"
+#include "shared/structs.h"
 #include "scene/scene.h"
 #include "unit/stat_util.h"
 
@@ -27,6 +28,36 @@ inline RenderResult render(const Scene& scene, const DenseGrid* grid = nullptr, 
   o.localSizeX = lx;
   o.localSizeY = ly;
   return renderPathtrace(runtime(), scene, grid, o);
+}
+
+// An absorption-only homogeneous box (σa = 0.7, 1 unit thick along z) between the camera and a
+// large rectangle light (Le = (2, 3, 4)) facing it, seen through a 2° field of view so every camera
+// ray crosses the box face to face and then hits the light. `renderer` is the JSON renderer object.
+inline std::string absorptionBoxJson(const std::string& renderer) {
+  return R"({
+    "materials": [
+      {"name": "light", "type": "emitter", "albedo": [2, 3, 4]},
+      {"name": "absorber", "type": "volume", "scattering": [0, 0, 0], "absorption": [0.7, 0.7, 0.7],
+       "phaseFunction": "isotropic", "density": 1}
+    ],
+    "primitives": [
+      {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 5], "scale": [40, 40, 1]},
+       "materialName": "light"},
+      {"name": "box", "type": "volume", "transform": {"position": [0, 0, 0], "scale": [2, 2, 1]},
+       "materialName": "absorber"}
+    ],
+    "camera": {"position": [0, 0, -10], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 2},
+    "renderer": )" + renderer + "}";
+}
+constexpr double kAbsorptionBoxSigma = 0.7;
+constexpr double kAbsorptionBoxLe[3] = {2, 3, 4};
+
+// exp(−σ/cos θ) for the ray through the centre of pixel (x, y): the transmittance of the unit-thick
+// absorption box along it (forward = +z, so 1/cos θ = |(sx, sy, 1)|).
+inline double absorptionBoxTransmittance(const camera_params& c, int x, int y) {
+  const double sx = (2.0 * (x + 0.5) / c.width - 1) * c.tan_half_vfov * c.aspect;
+  const double sy = (1 - 2.0 * (y + 0.5) / c.height) * c.tan_half_vfov;
+  return std::exp(-kAbsorptionBoxSigma * std::sqrt(1.0 + sx * sx + sy * sy));
 }
 
 // Mean and standard error of the image mean for channel c (pixels as independent samples).
