@@ -1,0 +1,46 @@
+// image_compare.h: perceptual comparison of two renders (DESIGN.md "Perceptual metric"). Both go
+// through the same display transform (exposure, tone mapping, clip to [0, 1]; no sRGB curve: the
+// values stay linear), then linear sRGB -> CIELAB, and each pixel gets ΔE76 and ΔE2000.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "scene/scene.h"
+
+namespace narval {
+
+struct DeltaEStats {
+  double mean = 0, p95 = 0, max = 0;
+  double jndPercent = 0;  // % of pixels with ΔE > kJnd
+};
+
+struct ImageComparison {
+  int width = 0, height = 0;
+  std::vector<float> dE76, dE2000;  // per pixel, row 0 at the top
+  DeltaEStats stats76, stats2000;
+};
+
+struct DisplaySettings {
+  float exposureStops = 0.0f;
+  ToneMapping toneMapping = ToneMapping::None;
+};
+
+// Throws InputError naming `testName` when the sizes differ ("size 10x8 differs from the
+// reference's 12x8") or either image holds NaN/Inf ("… holds 3 non-finite values"), naming the
+// image with the problem.
+ImageComparison compareImages(const ImageRGB& reference, const ImageRGB& test, const DisplaySettings& display,
+                              const std::string& referenceName = "reference", const std::string& testName = "test");
+
+// ΔE colour map (a perceptually ordered ramp from 0 to `maxDeltaE`, values above it saturate) with
+// a legend bar and tick labels along the bottom, as PNG.
+void writeDeltaEHeatmap(const std::string& path, const std::vector<float>& deltaE, int width, int height,
+                        float maxDeltaE = 10.0f);
+
+// The test image (display-transformed, sRGB-encoded, greyed) with the pixels over kJnd in red and
+// the percentage printed on it, as PNG (dissertation Figs. 5.4, 5.8).
+void writeJndMap(const std::string& path, const ImageRGB& image, const DisplaySettings& display,
+                 const std::vector<float>& deltaE, double jndPercent);
+
+}  // namespace narval
