@@ -16,5 +16,7 @@ struct Command {
 Command addRenderCommand(CLI::App& app);
 Command addDevicesCommand(CLI::App& app);
 Command addMakeCloudCommand(CLI::App& app);
+Command addCompareCommand(CLI::App& app);
+Command addSweepCommand(CLI::App& app);
 
 }  // namespace narval

@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("narval ") + NARVAL_VERSION);
   const std::vector<narval::Command> commands = {narval::addRenderCommand(app), narval::addDevicesCommand(app),
-                                                 narval::addMakeCloudCommand(app)};
+                                                 narval::addMakeCloudCommand(app), narval::addCompareCommand(app),
+                                                 narval::addSweepCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,232 @@
+// `narval compare` as a user runs it: exit codes, the one-line errors, the table, the --json keys
+// and values on a constructed pair, and the map files.
+//
+// The pair (derivation in tests/unit/image_compare_test.cpp): 10x8 greys, reference 0.125 (L* 42)
+// everywhere; in the test, 12 pixels 0.216 (L* 53.6, ΔE76 11.6) and 20 pixels 0.125·1.01³
+// (L* 42.58, ΔE76 0.58). Mean ΔE76 = (12·11.6 + 20·0.58)/80 = 1.885, p95 = max = 11.6,
+// JND% = 15; ΔE2000 = ΔL*/S_L for greys.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "image/image.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace narval {
+namespace {
+
+struct RunResult {
+  int code = -1;
+  std::string out, err;
+};
+
+ImageRGB uniform(int w, int h, float v) {
+  ImageRGB im;
+  im.width = w;
+  im.height = h;
+  im.rgb.assign(size_t(w) * size_t(h) * 3, v);
+  return im;
+}
+
+class CompareCli : public ::testing::Test {
+ protected:
+  RunResult run(const std::string& args) {
+    const std::string cmd =
+        "cd '" + dir_.string() + "' && '" + std::string(NARVAL_BINARY) + "' " + args + " > stdout.txt 2> stderr.txt";
+    const int status = std::system(cmd.c_str());
+    RunResult r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = test::readFile(dir_ / "stdout.txt");
+    r.err = test::readFile(dir_ / "stderr.txt");
+    fs::remove(dir_ / "stdout.txt");
+    fs::remove(dir_ / "stderr.txt");
+    return r;
+  }
+  void writeImage(const std::string& name, const ImageRGB& im) { writeExr((dir_ / name).string(), im); }
+  // The pair above, every value multiplied by `scale` (to be undone by --exposure).
+  void writePair(const std::string& ref, const std::string& test, float scale) {
+    ImageRGB a = uniform(10, 8, 0.125f * scale), b = a;
+    for (int i = 0; i < 32; ++i) {
+      const float v = (i < 12 ? 0.216f : 0.125f * 1.030301f) * scale;
+      float* p = b.pixel(i % 10, i / 10);
+      p[0] = p[1] = p[2] = v;
+    }
+    writeImage(ref, a);
+    writeImage(test, b);
+  }
+  // Files in the folder other than `inputs`.
+  std::vector<std::string> outputs(const std::vector<std::string>& inputs) {
+    std::vector<std::string> found;
+    for (const std::string& n : tmp_.entries())
+      if (std::find(inputs.begin(), inputs.end(), n) == inputs.end()) found.push_back(n);
+    return found;
+  }
+  test::TempDir tmp_{"narval_compare_cli"};
+  const fs::path dir_ = tmp_.path();
+};
+
+double grey2000(double c1, double c2) {
+  const double l1 = 116 * c1 - 16, l2 = 116 * c2 - 16, lBar = (l1 + l2) / 2, d = (lBar - 50) * (lBar - 50);
+  return std::fabs(l1 - l2) / (1.0 + 0.015 * d / std::sqrt(20.0 + d));
+}
+
+void expectPairJson(const nlohmann::json& j) {
+  EXPECT_EQ(j["width"], 10);
+  EXPECT_EQ(j["height"], 8);
+  EXPECT_NEAR(j["mean_dE76"].get<double>(), 1.885, 1e-4);
+  EXPECT_NEAR(j["p95_dE76"].get<double>(), 11.6, 1e-4);
+  EXPECT_NEAR(j["max_dE76"].get<double>(), 11.6, 1e-4);
+  EXPECT_DOUBLE_EQ(j["jnd76_pct"].get<double>(), 15.0);
+  const double far00 = grey2000(0.5, 0.6), near00 = grey2000(0.5, 0.505);
+  EXPECT_NEAR(j["mean_dE2000"].get<double>(), (12 * far00 + 20 * near00) / 80, 1e-4);
+  EXPECT_NEAR(j["p95_dE2000"].get<double>(), far00, 1e-4);
+  EXPECT_NEAR(j["max_dE2000"].get<double>(), far00, 1e-4);
+  EXPECT_DOUBLE_EQ(j["jnd2000_pct"].get<double>(), 15.0);
+}
+
+TEST_F(CompareCli, IdenticalImagesGiveZero) {
+  ImageRGB im = uniform(9, 7, 0.0f);
+  for (size_t i = 0; i < im.rgb.size(); ++i) im.rgb[i] = float(i % 17) / 8.0f;
+  writeImage("a.exr", im);
+  writeImage("b.exr", im);
+  const RunResult t = run("compare a.exr b.exr");
+  ASSERT_EQ(t.code, 0) << t.err;
+  EXPECT_EQ(t.err, "");
+  EXPECT_NE(t.out.find("dE76         0.0000     0.0000     0.0000      0.00%"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("dE2000       0.0000     0.0000     0.0000      0.00%"), std::string::npos) << t.out;
+  const RunResult j = run("compare a.exr b.exr --json --exposure 2 --tonemap aces");
+  ASSERT_EQ(j.code, 0) << j.err;
+  const nlohmann::json v = nlohmann::json::parse(j.out);
+  for (const char* key :
+       {"mean_dE76", "p95_dE76", "max_dE76", "jnd76_pct", "mean_dE2000", "p95_dE2000", "max_dE2000", "jnd2000_pct"})
+    EXPECT_EQ(v[key].get<double>(), 0.0) << key;
+}
+
+TEST_F(CompareCli, JsonKeysAndValuesOnAConstructedPair) {
+  writePair("ref.exr", "test.exr", 1.0f);
+  const RunResult r = run("compare ref.exr test.exr --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  std::vector<std::string> keys;
+  for (const auto& item : j.items()) keys.push_back(item.key());
+  std::sort(keys.begin(), keys.end());
+  EXPECT_EQ(keys, (std::vector<std::string>{"exposure", "height", "jnd2000_pct", "jnd76_pct", "max_dE2000", "max_dE76",
+                                            "mean_dE2000", "mean_dE76", "p95_dE2000", "p95_dE76", "reference", "test",
+                                            "tonemap", "width"}));
+  EXPECT_EQ(j["reference"], "ref.exr");
+  EXPECT_EQ(j["test"], "test.exr");
+  EXPECT_EQ(j["exposure"], 0.0);
+  EXPECT_EQ(j["tonemap"], "none");
+  expectPairJson(j);
+}
+
+TEST_F(CompareCli, ExposureAndToneMappingApplyToBoth) {
+  // Files 4x brighter, compared at −2 stops: the same numbers.
+  writePair("ref.exr", "test.exr", 4.0f);
+  const RunResult r = run("compare ref.exr test.exr --json --exposure -2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["exposure"], -2.0);
+  expectPairJson(j);
+  // 1.0 against 2.0: equal once clipped, different through Reinhard (1/2 vs 2/3).
+  writeImage("one.exr", uniform(3, 3, 1.0f));
+  writeImage("two.exr", uniform(3, 3, 2.0f));
+  const RunResult none = run("compare one.exr two.exr --json");
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_EQ(nlohmann::json::parse(none.out)["max_dE76"].get<double>(), 0.0);
+  const RunResult rh = run("compare one.exr two.exr --json --tonemap reinhard");
+  ASSERT_EQ(rh.code, 0) << rh.err;
+  const nlohmann::json k = nlohmann::json::parse(rh.out);
+  EXPECT_EQ(k["tonemap"], "reinhard");
+  EXPECT_NEAR(k["mean_dE76"].get<double>(), 116.0 * (std::cbrt(2.0 / 3.0) - std::cbrt(0.5)), 1e-4);
+  EXPECT_DOUBLE_EQ(k["jnd76_pct"].get<double>(), 100.0);
+}
+
+TEST_F(CompareCli, TableShowsBothMetrics) {
+  writePair("ref.exr", "test.exr", 1.0f);
+  const RunResult r = run("compare ref.exr test.exr");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("dE76         1.8850    11.6000    11.6000     15.00%"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("dE2000 "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("10x8"), std::string::npos) << r.out;
+}
+
+TEST_F(CompareCli, WritesTheMaps) {
+  writePair("ref.exr", "test.exr", 1.0f);
+  const RunResult r = run("compare ref.exr test.exr --heatmap maps/heat.png --jnd-map maps/jnd.png --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(nlohmann::json::accept(r.out)) << r.out;  // stdout stays pure JSON
+  for (const char* f : {"maps/heat.png", "maps/jnd.png"}) {
+    const std::string bytes = test::readFile(dir_ / f);
+    ASSERT_GE(bytes.size(), 8u) << f;
+    EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << f;
+  }
+  EXPECT_EQ(outputs({"ref.exr", "test.exr"}), std::vector<std::string>{"maps"});
+}
+
+// Bad input: exit 2, one line on stderr, nothing written.
+TEST_F(CompareCli, SizeMismatch) {
+  writeImage("ref.exr", uniform(12, 8, 0.5f));
+  writeImage("test.exr", uniform(10, 8, 0.5f));
+  const RunResult r = run("compare ref.exr test.exr --heatmap heat.png");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "narval: test.exr: size 10x8 differs from the reference's 12x8\n");
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(outputs({"ref.exr", "test.exr"}), std::vector<std::string>{});
+}
+
+TEST_F(CompareCli, NonFiniteValuesAreCounted) {
+  ImageRGB bad = uniform(6, 4, 0.5f);
+  bad.rgb[1] = std::numeric_limits<float>::quiet_NaN();
+  bad.rgb[10] = std::numeric_limits<float>::quiet_NaN();
+  bad.rgb[20] = std::numeric_limits<float>::infinity();
+  writeImage("ref.exr", uniform(6, 4, 0.5f));
+  writeImage("test.exr", bad);
+  const RunResult r = run("compare ref.exr test.exr --jnd-map jnd.png");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "narval: test.exr: holds 3 non-finite values\n");
+  EXPECT_EQ(outputs({"ref.exr", "test.exr"}), std::vector<std::string>{});
+  const RunResult s = run("compare test.exr ref.exr");
+  EXPECT_EQ(s.code, 2);
+  EXPECT_EQ(s.err, "narval: test.exr: holds 3 non-finite values\n");
+}
+
+TEST_F(CompareCli, UnreadableInput) {
+  writeImage("ref.exr", uniform(4, 4, 0.5f));
+  const RunResult r = run("compare ref.exr missing.exr");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("narval: missing.exr: ", 0), 0u) << r.err;
+  test::writeFile(dir_ / "junk.exr", "not an exr");
+  const RunResult j = run("compare junk.exr ref.exr");
+  EXPECT_EQ(j.code, 2);
+  EXPECT_EQ(std::count(j.err.begin(), j.err.end(), '\n'), 1) << j.err;
+  EXPECT_EQ(j.err.rfind("narval: junk.exr: ", 0), 0u) << j.err;
+}
+
+TEST_F(CompareCli, BadOptions) {
+  writeImage("a.exr", uniform(4, 4, 0.5f));
+  const RunResult tm = run("compare a.exr a.exr --tonemap filmic");
+  EXPECT_EQ(tm.code, 2);
+  EXPECT_EQ(tm.err, "narval: --tonemap: expected none, reinhard or aces, got 'filmic'\n");
+  const RunResult ext = run("compare a.exr a.exr --heatmap heat.jpg");
+  EXPECT_EQ(ext.code, 2);
+  EXPECT_EQ(ext.err, "narval: --heatmap: the output must be a .png file, got 'heat.jpg'\n");
+  const RunResult one = run("compare a.exr");
+  EXPECT_EQ(one.code, 2);
+  EXPECT_EQ(std::count(one.err.begin(), one.err.end(), '\n'), 1) << one.err;
+  EXPECT_EQ(outputs({"a.exr"}), std::vector<std::string>{});
+  // Upper case tone-mapping names are accepted.
+  EXPECT_EQ(run("compare a.exr a.exr --tonemap ACES").code, 0);
+}
+
+}  // namespace
+}  // namespace narval
