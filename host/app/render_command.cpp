@@ -1,13 +1,12 @@
 #include <filesystem>
 #include <cstdio>
 #include <iostream>
-#include <regex>
 
 #include <nlohmann/json.hpp>
 
+#include "app/cli_common.h"
 #include "app/commands.h"
 #include "app/progress_bar.h"
-#include "image/atomic_file.h"
 #include "image/image.h"
 #include "render/pathtrace_renderer.h"
 #include "render/realtime_renderer.h"
@@ -26,15 +25,6 @@ struct RenderArgs {
   std::vector<std::string> sets;
 };
 
-// "WxH" -> {W, H}; `what` names the option in the error.
-std::pair<int, int> parseSize(const std::string& text, const std::string& what) {
-  std::smatch m;
-  static const std::regex re(R"(^(\d{1,6})x(\d{1,6})$)");
-  if (!std::regex_match(text, m, re) || std::stoi(m[1]) == 0 || std::stoi(m[2]) == 0)
-    throw inputError(what, "", "expected WIDTHxHEIGHT with positive integers, got '" + text + "'");
-  return {std::stoi(m[1]), std::stoi(m[2])};
-}
-
 // Command-line options become --set overrides, so the scene validator checks them all alike.
 std::vector<std::string> overridesFrom(const RenderArgs& a) {
   std::vector<std::string> o = a.sets;
@@ -47,18 +37,6 @@ std::vector<std::string> overridesFrom(const RenderArgs& a) {
     o.push_back("renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]");
   }
   return o;
-}
-
-const Material* volumeMaterial(const Scene& scene) {
-  for (const Primitive& p : scene.primitives)
-    if (p.type == PrimitiveType::Volume) return &scene.materials.at(size_t(p.materialIndex));
-  return nullptr;
-}
-
-void writeTextAtomic(const std::string& path, const std::string& text) {
-  AtomicFile f(path);
-  if (std::fwrite(text.data(), 1, text.size(), f.file()) != text.size()) f.fail("short write");
-  f.commit();
 }
 
 nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
@@ -105,10 +83,8 @@ int runRender(const RenderArgs& a) {
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
 
   // Everything the render needs is loaded and checked before the first sample.
-  DenseGrid grid;
-  const Material* vm = volumeMaterial(scene);
-  const bool hasGrid = vm && !vm->path.empty();
-  if (hasGrid) grid = loadGrid(vm->path, vm->gridName);
+  DenseGrid gridStorage;
+  const DenseGrid* g = loadSceneGrid(scene, gridStorage);
   ClRuntime rt(a.device);
 
   ProgressBar bar((realtime ? "frames of " : "rendering ") + fs::path(a.scene).filename().string());
@@ -116,7 +92,6 @@ int runRender(const RenderArgs& a) {
   options.localSizeX = lx;
   options.localSizeY = ly;
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
-  const DenseGrid* g = hasGrid ? &grid : nullptr;
   // --frames with the path tracer: K passes of one sample per pixel (a frame each), K spp in all.
   if (a.frames > 0 && !realtime) {
     scene.renderer.spp = a.frames;

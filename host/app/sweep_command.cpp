@@ -8,9 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/cli_common.h"
 #include "app/commands.h"
 #include "app/progress_bar.h"
-#include "image/atomic_file.h"
 #include "image/image.h"
 #include "image/image_compare.h"
 #include "render/pathtrace_renderer.h"
@@ -38,26 +38,6 @@ int parseSingle(const std::string& text, const std::string& option, int minimum)
                      std::string("expected ") + (minimum > 0 ? "a positive" : "a non-negative") + " integer, got '" +
                          text + "'");
   return int(std::stoll(m[1]));
-}
-
-std::pair<int, int> parseSize(const std::string& text) {
-  std::smatch m;
-  static const std::regex re(R"(^(\d{1,6})x(\d{1,6})$)");
-  if (!std::regex_match(text, m, re) || std::stoi(m[1]) == 0 || std::stoi(m[2]) == 0)
-    throw inputError("--resolution", "", "expected WIDTHxHEIGHT with positive integers, got '" + text + "'");
-  return {std::stoi(m[1]), std::stoi(m[2])};
-}
-
-const Material* volumeMaterial(const Scene& scene) {
-  for (const Primitive& p : scene.primitives)
-    if (p.type == PrimitiveType::Volume) return &scene.materials.at(size_t(p.materialIndex));
-  return nullptr;
-}
-
-void writeTextAtomic(const std::string& path, const std::string& text) {
-  AtomicFile f(path);
-  if (std::fwrite(text.data(), 1, text.size(), f.file()) != text.size()) f.fail("short write");
-  f.commit();
 }
 
 bool isList(const std::string& s) { return s.find(',') != std::string::npos; }
@@ -90,7 +70,7 @@ int runSweepCommand(const SweepArgs& a) {
   if (!sweepSpp && hasSpp) overrides.push_back("renderer.spp=" + std::to_string(parseSingle(a.spp, "--spp", 1)));
   if (a.seed >= 0) overrides.push_back("renderer.seed=" + std::to_string(a.seed));
   if (!a.resolution.empty()) {
-    const auto [w, h] = parseSize(a.resolution);
+    const auto [w, h] = parseSize(a.resolution, "--resolution");
     overrides.push_back("renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]");
   }
   Scene scene = loadScene(a.scene, overrides);
@@ -104,10 +84,8 @@ int runSweepCommand(const SweepArgs& a) {
   if (fs::exists(dir) && !fs::is_directory(dir))
     throw inputError("-o", "", "'" + a.out + "' exists and is not a folder");
 
-  DenseGrid grid;
-  const Material* vm = volumeMaterial(scene);
-  const bool hasGrid = vm && !vm->path.empty();
-  if (hasGrid) grid = loadGrid(vm->path, vm->gridName);
+  DenseGrid gridStorage;
+  const DenseGrid* g = loadSceneGrid(scene, gridStorage);
   ImageRGB reference;
   if (!a.reference.empty()) {
     reference = readExr(a.reference);
@@ -118,7 +96,6 @@ int runSweepCommand(const SweepArgs& a) {
   // ---- render
   fs::create_directories(dir);
   const std::string sceneName = fs::path(a.scene).filename().string();
-  const DenseGrid* g = hasGrid ? &grid : nullptr;
   bool warned = false;
   SweepRenderer render = [&](const Scene& s) {
     const int value = sweepSpp ? s.renderer.spp : s.renderer.bounces;

@@ -1,0 +1,36 @@
+#include "app/cli_common.h"
+
+#include <cstdio>
+#include <regex>
+
+#include "image/atomic_file.h"
+#include "scene/input_error.h"
+
+namespace narval {
+
+std::pair<int, int> parseSize(const std::string& text, const std::string& what) {
+  std::smatch m;
+  static const std::regex re(R"(^(\d{1,6})x(\d{1,6})$)");
+  if (!std::regex_match(text, m, re) || std::stoi(m[1]) == 0 || std::stoi(m[2]) == 0)
+    throw inputError(what, "", "expected WIDTHxHEIGHT with positive integers, got '" + text + "'");
+  return {std::stoi(m[1]), std::stoi(m[2])};
+}
+
+const DenseGrid* loadSceneGrid(const Scene& scene, DenseGrid& storage) {
+  for (const Primitive& p : scene.primitives) {
+    if (p.type != PrimitiveType::Volume) continue;
+    const Material& m = scene.materials.at(size_t(p.materialIndex));
+    if (m.path.empty()) return nullptr;
+    storage = loadGrid(m.path, m.gridName);
+    return &storage;
+  }
+  return nullptr;
+}
+
+void writeTextAtomic(const std::string& path, const std::string& text) {
+  AtomicFile f(path);
+  if (std::fwrite(text.data(), 1, text.size(), f.file()) != text.size()) f.fail("short write");
+  f.commit();
+}
+
+}  // namespace narval

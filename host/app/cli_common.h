@@ -1,0 +1,23 @@
+// cli_common.h: small pieces several subcommands share (option parsing, loading a scene's grid,
+// writing text outputs).
+#pragma once
+
+#include <string>
+#include <utility>
+
+#include "scene/scene.h"
+#include "volume/grid.h"
+
+namespace narval {
+
+// "WxH" -> {W, H} (positive); `what` names the option in the InputError.
+std::pair<int, int> parseSize(const std::string& text, const std::string& what);
+
+// Loads the grid of the scene's volume primitive into `storage` and returns it, or null when the
+// scene has no volume or a homogeneous one. Throws InputError from the grid loader.
+const DenseGrid* loadSceneGrid(const Scene& scene, DenseGrid& storage);
+
+// Writes `text` to `path` through a temporary file and a rename (never a half-written file).
+void writeTextAtomic(const std::string& path, const std::string& text);
+
+}  // namespace narval
