@@ -21,7 +21,9 @@ static inline float phase_hg_denominator(float g, float mu) {
 
 static inline float phase_hg_eval(float g, float mu) {
   if (nv_fabs(g) < PHASE_HG_ISOTROPIC_EPS) return NV_INV_4PI;
-  const float d = phase_hg_denominator(g, mu);
+  /* A cosine rebuilt from unit vectors can exceed 1 by a few ulps; near |g| = 1 that would turn the
+   * denominator, (1−|g|)² + 2|g|(1∓μ), negative. */
+  const float d = phase_hg_denominator(g, nv_fmin(1.0f, nv_fmax(-1.0f, mu)));
   return NV_INV_4PI * (1.0f - g) * (1.0f + g) / (d * nv_sqrt(d));
 }
 
