@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "image/image.h"
+#include "cli/cli_fixture.h"
 #include "test_support.h"
 #include "volume/grid.h"
 
@@ -17,42 +18,14 @@ namespace fs = std::filesystem;
 namespace narval {
 namespace {
 
-struct RunResult {
-  int code = -1;
-  std::string out, err;
-};
-
 using test::listing41Json;
 using test::readFile;
 using test::realDataPath;
 
+using test::RunResult;
+
 // Each test runs narval in a fresh folder of its own.
-class Cli : public ::testing::Test {
- protected:
-  // Runs `narval ARGS` in the test's folder; stdout and stderr captured to files.
-  RunResult run(const std::string& args) {
-    const std::string cmd = "cd '" + dir_.string() + "' && '" + std::string(NARVAL_BINARY) + "' " + args +
-                            " > stdout.txt 2> stderr.txt";
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = readFile(dir_ / "stdout.txt");
-    r.err = readFile(dir_ / "stderr.txt");
-    fs::remove(dir_ / "stdout.txt");
-    fs::remove(dir_ / "stderr.txt");
-    return r;
-  }
-  void write(const std::string& name, const std::string& text) { test::writeFile(dir_ / name, text); }
-  // Files in the folder other than the inputs the test wrote.
-  std::vector<std::string> outputs(const std::vector<std::string>& inputs) {
-    std::vector<std::string> found;
-    for (const std::string& n : tmp_.entries())
-      if (std::find(inputs.begin(), inputs.end(), n) == inputs.end()) found.push_back(n);
-    return found;
-  }
-  test::TempDir tmp_{"narval_cli"};
-  const fs::path dir_ = tmp_.path();
-};
+class Cli : public test::CliFixture {};
 
 TEST_F(Cli, Listing41RendersWithOverrides) {
   writeVdb((dir_ / "cloud.vdb").string(), makeCloud(16, 1));

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "image/image.h"
+#include "cli/cli_fixture.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -22,10 +23,7 @@ namespace fs = std::filesystem;
 namespace narval {
 namespace {
 
-struct RunResult {
-  int code = -1;
-  std::string out, err;
-};
+using test::RunResult;
 
 ImageRGB uniform(int w, int h, float v) {
   ImageRGB im;
@@ -35,20 +33,8 @@ ImageRGB uniform(int w, int h, float v) {
   return im;
 }
 
-class CompareCli : public ::testing::Test {
+class CompareCli : public test::CliFixture {
  protected:
-  RunResult run(const std::string& args) {
-    const std::string cmd =
-        "cd '" + dir_.string() + "' && '" + std::string(NARVAL_BINARY) + "' " + args + " > stdout.txt 2> stderr.txt";
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = test::readFile(dir_ / "stdout.txt");
-    r.err = test::readFile(dir_ / "stderr.txt");
-    fs::remove(dir_ / "stdout.txt");
-    fs::remove(dir_ / "stderr.txt");
-    return r;
-  }
   void writeImage(const std::string& name, const ImageRGB& im) { writeExr((dir_ / name).string(), im); }
   // The pair above, every value multiplied by `scale` (to be undone by --exposure).
   void writePair(const std::string& ref, const std::string& test, float scale) {
@@ -61,15 +47,6 @@ class CompareCli : public ::testing::Test {
     writeImage(ref, a);
     writeImage(test, b);
   }
-  // Files in the folder other than `inputs`.
-  std::vector<std::string> outputs(const std::vector<std::string>& inputs) {
-    std::vector<std::string> found;
-    for (const std::string& n : tmp_.entries())
-      if (std::find(inputs.begin(), inputs.end(), n) == inputs.end()) found.push_back(n);
-    return found;
-  }
-  test::TempDir tmp_{"narval_compare_cli"};
-  const fs::path dir_ = tmp_.path();
 };
 
 double grey2000(double c1, double c2) {

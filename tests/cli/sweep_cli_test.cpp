@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "image/image.h"
+#include "cli/cli_fixture.h"
 #include "test_support.h"
 #include "volume/grid.h"
 
@@ -20,10 +21,7 @@ namespace fs = std::filesystem;
 namespace narval {
 namespace {
 
-struct RunResult {
-  int code = -1;
-  std::string out, err;
-};
+using test::RunResult;
 
 // A table row of sweep.csv.
 struct CsvRow {
@@ -44,23 +42,11 @@ std::pair<uint32_t, uint32_t> pngSize(const std::string& bytes) {
 }
 
 // Each test runs narval in a fresh folder holding a generated 16^3 cloud under Listing 4.1.
-class SweepCli : public ::testing::Test {
+class SweepCli : public test::CliFixture {
  protected:
   void SetUp() override {
     writeVdb((dir_ / "cloud.vdb").string(), makeCloud(16, 1));
     test::writeFile(dir_ / "scene.json", test::listing41Json("cloud.vdb"));
-  }
-  RunResult run(const std::string& args) {
-    const std::string cmd = "cd '" + dir_.string() + "' && '" + std::string(NARVAL_BINARY) + "' " + args +
-                            " > stdout.txt 2> stderr.txt";
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = test::readFile(dir_ / "stdout.txt");
-    r.err = test::readFile(dir_ / "stderr.txt");
-    fs::remove(dir_ / "stdout.txt");
-    fs::remove(dir_ / "stderr.txt");
-    return r;
   }
   std::vector<CsvRow> readCsv(const std::string& name) {
     std::istringstream in(test::readFile(dir_ / name));
@@ -94,9 +80,6 @@ class SweepCli : public ::testing::Test {
     EXPECT_EQ(r.dE2000, 0.0);
     EXPECT_EQ(r.jnd2000, 0.0);
   }
-
-  test::TempDir tmp_{"narval_sweep_cli"};
-  const fs::path dir_ = tmp_.path();
 };
 
 TEST_F(SweepCli, SppSweepWritesEveryFileLargestFirst) {

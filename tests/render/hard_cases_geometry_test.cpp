@@ -29,26 +29,6 @@ RenderResult renderWith(Scene scene, const std::string& algorithm, const DenseGr
 
 const char* const kAlgorithms[] = {"pathtrace", "raymarch", "lobe"};
 
-struct Ray {
-  double o[3], d[3];
-};
-
-// The ray through image position (fx, fy) (pixel units, (0,0) the top-left corner) of the scene's
-// pinhole camera, in double (camera.h's formula, as in raymarch_test.cpp).
-Ray pixelRay(const camera_params& c, double fx, double fy) {
-  const double sx = (2 * fx / c.width - 1) * c.tan_half_vfov * c.aspect;
-  const double sy = (1 - 2 * fy / c.height) * c.tan_half_vfov;
-  Ray r{{c.position.x, c.position.y, c.position.z}, {}};
-  const double f[3] = {c.forward.x, c.forward.y, c.forward.z}, rt[3] = {c.right.x, c.right.y, c.right.z},
-               up[3] = {c.up.x, c.up.y, c.up.z};
-  double n = 0;
-  for (int k = 0; k < 3; ++k) {
-    r.d[k] = f[k] + sx * rt[k] + sy * up[k];
-    n += r.d[k] * r.d[k];
-  }
-  for (double& v : r.d) v /= std::sqrt(n);
-  return r;
-}
 
 // The ray mapped into index space by world_to_index (an affine map: the world parameter t is kept).
 struct IndexRay {

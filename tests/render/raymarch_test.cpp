@@ -29,27 +29,6 @@ RenderResult raymarch(Scene scene, const DenseGrid* grid = nullptr, int lx = 8, 
   return renderRealtime(runtime(), scene, grid, 1, o);
 }
 
-struct Ray {
-  double o[3], d[3];
-};
-
-// The ray through image position (fx, fy) (pixel units, (0,0) the top-left corner) of the scene's
-// pinhole camera, in double (camera.h's formula); the centre of pixel (px, py) is (px + ½, py + ½).
-Ray pixelRay(const camera_params& c, double fx, double fy) {
-  const double sx = (2 * fx / c.width - 1) * c.tan_half_vfov * c.aspect;
-  const double sy = (1 - 2 * fy / c.height) * c.tan_half_vfov;
-  Ray r{{c.position.x, c.position.y, c.position.z}, {}};
-  const double f[3] = {c.forward.x, c.forward.y, c.forward.z}, rt[3] = {c.right.x, c.right.y, c.right.z},
-               up[3] = {c.up.x, c.up.y, c.up.z};
-  double n = 0;
-  for (int k = 0; k < 3; ++k) {
-    r.d[k] = f[k] + sx * rt[k] + sy * up[k];
-    n += r.d[k] * r.d[k];
-  }
-  for (double& v : r.d) v /= std::sqrt(n);
-  return r;
-}
-Ray pixelCentreRay(const camera_params& c, int px, int py) { return pixelRay(c, px + 0.5, py + 0.5); }
 
 double hg(double g, double mu) { return (1 - g * g) / (4 * kPi * std::pow(1 + g * g - 2 * g * mu, 1.5)); }
 
