@@ -2,6 +2,7 @@
 #pragma once
 
 #include <map>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,15 @@ ImageRGB readExr(const std::string& path);
 // The string attributes of an EXR header (what writeExr's `attributes` put there), by name;
 // throws InputError like readExr.
 std::map<std::string, std::string> readExrAttributes(const std::string& path);
+
+// 8-bit RGB pictures (display images, figures); row 0 at the top.
+struct ImageRGB8 {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+
+// Atomic RGB8 PNG write of an 8-bit picture.
+void writePng8(const std::string& path, const ImageRGB8& image);
 
 // Display transform (display_transform.h): multiply by 2^exposure, tone map, clamp to [0, 1],
 // sRGB transfer, round to 8 bit; NaN shows as 0, +inf as 255. RGB8 PNG with an sRGB chunk, written

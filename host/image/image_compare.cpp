@@ -2,8 +2,6 @@
 // figures made from it: the ΔE heat map with its legend and the JND map.
 #include "image/image_compare.h"
 
-#include <png.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -11,7 +9,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "image/atomic_file.h"
 #include "image/bitmap_font.h"
 #include "image/cielab.h"
 #include "image/display_transform.h"
@@ -270,26 +267,6 @@ void drawText(ImageRGB8& image, int x, int y, const std::string& text, int scale
         if (rows[row] & (0x10 >> col))
           fill(image, gx + col * scale, y + row * scale, gx + (col + 1) * scale, y + (row + 1) * scale, r, g, b);
   }
-}
-
-void writePng8(const std::string& path, const ImageRGB8& image) {
-  if (image.width <= 0 || image.height <= 0)
-    throw std::runtime_error(writeErrorMessage(
-        path, "empty image (" + std::to_string(image.width) + "x" + std::to_string(image.height) + ")"));
-  if (image.rgb.size() != size_t(image.width) * size_t(image.height) * 3)
-    throw std::runtime_error(writeErrorMessage(path, "pixel buffer size does not match the image size"));
-  AtomicFile out(path);
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  png.width = png_uint_32(image.width);
-  png.height = png_uint_32(image.height);
-  png.format = PNG_FORMAT_RGB;
-  const png_int_32 rowStride = png_int_32(image.width) * 3;
-  const int ok = png_image_write_to_stdio(&png, out.file(), 0, image.rgb.data(), rowStride, nullptr);
-  const std::string message = png.message;
-  png_image_free(&png);
-  if (!ok) out.fail(message.empty() ? "libpng error" : message);
-  out.commit();
 }
 
 void writeDeltaEHeatmap(const std::string& path, const std::vector<float>& deltaE, int width, int height,

@@ -34,12 +34,6 @@ struct DisplaySettings {
 ImageComparison compareImages(const ImageRGB& reference, const ImageRGB& test, const DisplaySettings& display,
                               const std::string& referenceName = "reference", const std::string& testName = "test");
 
-// 8-bit RGB pictures for figures (maps, strips); row 0 at the top.
-struct ImageRGB8 {
-  int width = 0, height = 0;
-  std::vector<uint8_t> rgb;
-};
-
 // The image as displayed: display transform, then the sRGB curve, 8 bit (as writePng does).
 ImageRGB8 displayImage(const ImageRGB& image, const DisplaySettings& display);
 // The ΔE map and the JND map as pictures (what the two writers below save).
@@ -49,8 +43,6 @@ ImageRGB8 jndMapImage(const ImageRGB& image, const DisplaySettings& display, con
 // Text in a small built-in bitmap font (digits, letters, '%', '.', '-', ' '), `scale` pixels per
 // font pixel, at (x, y) = top-left.
 void drawText(ImageRGB8& image, int x, int y, const std::string& text, int scale, uint8_t r, uint8_t g, uint8_t b);
-// Atomic PNG write of an 8-bit picture.
-void writePng8(const std::string& path, const ImageRGB8& image);
 
 // ΔE colour map (a perceptually ordered ramp from 0 to `maxDeltaE`, values above it saturate) with
 // a legend bar and tick labels along the bottom, as PNG.
