@@ -6,10 +6,13 @@
 
 #include "app/cli_common.h"
 #include "app/commands.h"
+#include "app/interrupt.h"
 #include "app/progress_bar.h"
 #include "image/image.h"
 #include "render/pathtrace_renderer.h"
 #include "render/realtime_renderer.h"
+#include "render/render_common.h"
+#include "render/render_exr.h"
 #include "scene/input_error.h"
 #include "shared/structs.h"
 
@@ -20,7 +23,9 @@ namespace {
 
 struct RenderArgs {
   std::string scene, out, algorithm, resolution, device, statsJson, localSize = "8x8";
-  int spp = -1, bounces = -1, frames = 0;
+  int spp = -1, bounces = -1, frames = 0, samplesPerPass = 0, majorantResolution = 0;
+  bool resume = false, counters = false;
+  std::string majorant = "grid";
   long long seed = -1;
   std::vector<std::string> sets;
 };
@@ -45,6 +50,9 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"width", s.width},
           {"height", s.height},
           {"spp", s.spp},
+          {"spp_requested", s.sppRequested},
+          {"resumed_from_spp", s.resumedFromSpp},
+          {"interrupted", s.interrupted},
           {"bounces", s.bounces},
           {"seed", scene.renderer.seed},
           {"seconds", s.seconds},
@@ -54,6 +62,8 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"passes", s.passes},
           {"nan_pixels", s.nanPixels},
           {"program_from_cache", s.programFromCache},
+          {"majorant", s.majorant},
+          {"majorant_cells", {s.majorantCells[0], s.majorantCells[1], s.majorantCells[2]}},
           {"status",
            {{"nan", (s.status & STATUS_NAN) != 0},
             {"negative_pdf", (s.status & STATUS_NEGATIVE_PDF) != 0},
@@ -76,47 +86,85 @@ int runRender(const RenderArgs& a) {
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
   const bool realtime = scene.renderer.algorithm != "pathtrace";
   const auto [lx, ly] = parseSize(a.localSize, "--local-size");
+  if (a.counters && realtime)
+    throw inputError("--counters", "", "only the path tracer counts collisions; the algorithm is " + scene.renderer.algorithm);
 
   fs::path out = a.out.empty() ? fs::path(fs::path(a.scene).stem().string() + ".exr") : fs::path(a.out);
   if (out.extension() != ".exr") throw inputError("-o", "", "the output must be an .exr file, got '" + a.out + "'");
   const fs::path png = fs::path(out).replace_extension(".png");
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
 
+  // --resume: the accumulator of an earlier render of the same settings at the output path.
+  AccumulatorState resumeState;
+  bool resuming = false;
+  if (a.resume) {
+    if (realtime) throw inputError("--resume", "", "only path-traced renders resume; the algorithm is " + scene.renderer.algorithm);
+    if (fs::exists(out)) {
+      resumeState = readAccumulator(out.string(), scene);
+      resuming = true;
+      if (resumeState.samples == scene.renderer.spp) {
+        std::cout << out.string() << " already has " << resumeState.samples << " spp; nothing to render\n";
+        return 0;
+      }
+    } else {
+      std::cerr << "narval: --resume: " << out.string() << " does not exist yet; rendering from the first sample\n";
+    }
+  }
+
   // Everything the render needs is loaded and checked before the first sample.
   DenseGrid gridStorage;
   const DenseGrid* g = loadSceneGrid(scene, gridStorage);
+  const InterruptWatch interrupt;  // from here on, Ctrl-C stops after the pass in flight
   ClRuntime rt(a.device);
 
   ProgressBar bar((realtime ? "frames of " : "rendering ") + fs::path(a.scene).filename().string());
   RenderOptions options;
   options.localSizeX = lx;
   options.localSizeY = ly;
+  options.samplesPerPass = a.samplesPerPass;
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
+  options.cancel = &interrupt.flag();
+  if (resuming) options.resumeFrom = &resumeState;
   // --frames with the path tracer: K passes of one sample per pixel (a frame each), K spp in all.
   if (a.frames > 0 && !realtime) {
     scene.renderer.spp = a.frames;
     options.samplesPerPass = 1;
   }
+  options.majorant = a.majorant;
+  options.majorantResolution = a.majorantResolution;
+  options.counters = a.counters;
   const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)
                                   : renderPathtrace(rt, scene, g, options);
   bar.finish();
   for (const std::string& w : r.warnings) std::cerr << "narval: warning: " << w << "\n";
-
   const RenderStats& s = r.stats;
-  writeExr(out.string(), r.image,
-           {{"narval:algorithm", s.algorithm}, {"narval:spp", std::to_string(s.spp)},
-            {"narval:bounces", std::to_string(s.bounces)}, {"narval:seed", std::to_string(scene.renderer.seed)},
-            {"narval:scene", scene.sourcePath}, {"narval:device", s.device}});
+  if (r.image.width == 0) {
+    std::cerr << "narval: interrupted before the first " << (realtime ? "frame" : "pass") << "; nothing written\n";
+    return kExitInterrupted;
+  }
+
+  writeRenderExr(out.string(), r, scene);
   writePng(png.string(), r.image, scene.renderer.exposure, scene.renderer.toneMapping);
   if (!a.statsJson.empty()) {
     nlohmann::json j = statsJson(s, scene);
     if (a.frames > 0) j["ms_per_frame"] = framesJson(s.frames);
+    if (s.counters) {
+      j["collisions_tentative"] = s.collisionsTentative;
+      j["collisions_real"] = s.collisionsReal;
+      j["density_lookups"] = s.densityLookups;
+    }
     writeTextAtomic(a.statsJson, j.dump(2) + "\n");
   }
 
-  if (s.status & STATUS_NAN) std::cerr << "narval: warning: the kernel produced non-finite samples (dropped)\n";
-  if (s.status & STATUS_NEGATIVE_PDF) std::cerr << "narval: warning: the kernel met a non-positive pdf\n";
-  if (s.status & STATUS_ITERATION_CAP) std::cerr << "narval: warning: a tracking loop hit its iteration cap\n";
+  for (const std::string& w : statusWarnings(s.status)) std::cerr << "narval: warning: " << w << "\n";
+  if (s.interrupted) {
+    std::cerr << "narval: interrupted: wrote " << out.string() << " and " << png.string() << " with "
+              << (realtime ? std::to_string(s.passes) + " of " + std::to_string(std::max(1, a.frames)) + " frames"
+                           : std::to_string(s.spp) + " of " + std::to_string(s.sppRequested) +
+                                 " spp; --resume continues it")
+              << "\n";
+    return kExitInterrupted;
+  }
   if (a.frames > 0)
     std::cout << s.algorithm << ": " << s.frames.count << " frames, first " << s.frames.firstKernelMs
               << " ms, then median " << s.frames.medianKernelMs << " ms (min " << s.frames.minKernelMs << ", max "
@@ -152,6 +200,25 @@ Command addRenderCommand(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   sub->add_option("--stats-json", a->statsJson, "Write render statistics as JSON");
   sub->add_option("--local-size", a->localSize, "Work-group shape WxH (default 8x8); never changes the pixels");
+  sub->add_option("--samples-per-pass", a->samplesPerPass,
+                  "pathtrace: samples per pixel per launch (default: about 2^20 paths per launch); never "
+                  "changes the pixels")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--majorant", a->majorant,
+                  "pathtrace: majorant of delta and ratio tracking: grid (per cell of a coarse grid, walked by "
+                  "DDA; default) or global (one for the whole medium)")
+      ->check(CLI::IsMember({"grid", "global"}));
+  sub->add_option("--majorant-resolution", a->majorantResolution,
+                  "Majorant grid cells along the grid's longest axis (0: automatic)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--counters", a->counters,
+                "pathtrace: count tentative and real collisions and density lookups (a kernel built to count; "
+                "--stats-json reports them)");
+  CLI::Option* frames = sub->get_option("--frames");
+  sub->add_flag("--resume", a->resume,
+                "pathtrace: continue the render already at the output path (interrupted, or with fewer spp) "
+                "to the requested spp; the pixels equal those of one uninterrupted render")
+      ->excludes(frames);
   return {sub, [a]() { return runRender(*a); }};
 }
 

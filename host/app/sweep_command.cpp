@@ -14,6 +14,7 @@
 #include "image/image.h"
 #include "image/image_compare.h"
 #include "render/pathtrace_renderer.h"
+#include "render/render_common.h"
 #include "render/sweep.h"
 #include "scene/input_error.h"
 #include "shared/structs.h"
@@ -117,12 +118,8 @@ int runSweepCommand(const SweepArgs& a) {
               {"narval:bounces", std::to_string(st.bounces)}, {"narval:seed", std::to_string(scene.renderer.seed)},
               {"narval:scene", scene.sourcePath}, {"narval:device", st.device},
               {"narval:seconds", std::to_string(st.seconds)}});
-    if (st.status & STATUS_NAN)
-      std::cerr << "narval: warning: " << exr.string() << ": the kernel produced non-finite samples (dropped)\n";
-    if (st.status & STATUS_NEGATIVE_PDF)
-      std::cerr << "narval: warning: " << exr.string() << ": the kernel met a non-positive pdf\n";
-    if (st.status & STATUS_ITERATION_CAP)
-      std::cerr << "narval: warning: " << exr.string() << ": a tracking loop hit its iteration cap\n";
+    for (const std::string& w : statusWarnings(st.status))
+      std::cerr << "narval: warning: " << exr.string() << ": " << w << "\n";
     std::printf("%-14s %10.3f s", sweepLabel(parameter, row.value).c_str(), row.seconds);
     if (row.isReference)
       std::printf("  reference\n");

@@ -45,6 +45,11 @@ struct ClRuntime {
   SelectedDevice selected;
   cl::Context context;
   cl::CommandQueue queue;
+  // Appended to the options of every buildProgram on this runtime (after the caller's), e.g.
+  // "-DNARVAL_TRACKING_MAX_STEPS=8": tests force the kernels' iteration caps through it
+  // (tests/render/status_word_test.cpp). Part of the program cache key like any option. Empty in
+  // the application.
+  std::string extraBuildOptions;
   explicit ClRuntime(const std::string& deviceSpec);
 };
 
@@ -53,7 +58,8 @@ struct ProgramBuildError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Builds the embedded kernel file `kernelFile` (e.g. "pathtrace.cl") with `options` (-D defines).
+// Builds the embedded kernel file `kernelFile` (e.g. "pathtrace.cl") with `options` (-D defines)
+// and rt.extraBuildOptions.
 // `sources` defaults to kernelSources(); tests pass their own map. Built binaries are cached in
 // $NARVAL_CACHE_DIR, else $XDG_CACHE_HOME/narval, else ~/.cache/narval, keyed by a hash of the
 // flattened source, the options, platform, device and driver version; NARVAL_CACHE_DIR=off disables it.
@@ -61,6 +67,11 @@ struct ProgramBuildError : std::runtime_error {
 cl::Program buildProgram(ClRuntime& rt, const std::string& kernelFile, const std::string& options,
                          const std::map<std::string, std::string>* sources = nullptr,
                          bool* cacheHit = nullptr);
+
+// Drivers that ignore #line directives (NVIDIA's reports "<kernel>:76:25: error") get their
+// locations rewritten to the original "kernels/shared/phase.h:12:25:" by the markers the kernel
+// embedding left in `flattenedSource`; other text is kept as it is.
+std::string mapBuildLogLines(const std::string& log, const std::string& flattenedSource);
 
 // "CL_OUT_OF_RESOURCES (-5)" for an error code.
 std::string clErrorName(int code);

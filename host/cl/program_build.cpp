@@ -7,13 +7,16 @@
 // source, the full build options, platform name and version, device name and driver version. A
 // truncated or corrupt entry is a miss; a binary the driver refuses falls back to the source and
 // the entry is overwritten. The cache never makes a build fail: every cache I/O error is ignored.
+#include <unistd.h>
+
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <sstream>
-#include <unistd.h>
 
 #include "cl/cl_runtime.h"
 #include "cl/kernel_sources.h"
@@ -95,13 +98,52 @@ std::string buildLog(const cl::Program& program, const cl::Device& device) {
   }
 }
 
-[[noreturn]] void throwBuildError(const std::string& kernelFile, const cl::Error& e, std::string log) {
+[[noreturn]] void throwBuildError(const std::string& kernelFile, const cl::Error& e, std::string log,
+                                  const std::string& source) {
+  log = mapBuildLogLines(log, source);
   while (!log.empty() && (log.back() == '\n' || log.back() == '\0' || log.back() == ' ')) log.pop_back();
   if (log.empty()) log = clErrorText(e) + ", and the driver gave no build log";
   throw ProgramBuildError("OpenCL build of " + kernelFile + " failed:\n" + log);
 }
 
 }  // namespace
+
+std::string mapBuildLogLines(const std::string& log, const std::string& source) {
+  // (flattened line where a #line marker's next line starts, file, its line number there), in order.
+  struct Marker {
+    long flat;
+    std::string file;
+    long line;
+  };
+  std::vector<Marker> markers;
+  {
+    std::istringstream in(source);
+    std::string text;
+    const std::regex lineDirective(R"(^\s*#\s*line\s+(\d+)\s+"([^"]*)\")");
+    std::smatch m;
+    for (long flat = 1; std::getline(in, text); ++flat)
+      if (std::regex_search(text, m, lineDirective)) markers.push_back({flat + 1, m[2], std::stol(m[1])});
+  }
+  if (markers.empty()) return log;
+  const std::regex anonymous(R"(<(kernel|source)>:(\d+):)");
+  std::string out;
+  auto from = log.cbegin();
+  for (std::sregex_iterator it(log.begin(), log.end(), anonymous), end; it != end; ++it) {
+    const long flat = std::stol((*it)[2]);
+    auto after = std::upper_bound(markers.begin(), markers.end(), flat,
+                                  [](long f, const Marker& mk) { return f < mk.flat; });
+    out.append(from, log.cbegin() + it->position());
+    if (after == markers.begin()) {
+      out += it->str();
+    } else {
+      const Marker& mk = *(after - 1);
+      out += mk.file + ":" + std::to_string(mk.line + (flat - mk.flat)) + ":";
+    }
+    from = log.cbegin() + it->position() + it->length();
+  }
+  out.append(from, log.cend());
+  return out;
+}
 
 std::uint64_t fnv1a64(const std::string& data, std::uint64_t h) {
   for (unsigned char c : data) {
@@ -136,7 +178,8 @@ cl::Program buildProgram(ClRuntime& rt, const std::string& kernelFile, const std
   const std::string& source = found->second;
   // Sources are flattened at build time, so no -I; never -cl-fast-relaxed-math (DESIGN.md,
   // platform facts: it breaks determinism and isnan) unless the caller asks for it.
-  const std::string fullOptions = "-cl-std=CL1.2" + (options.empty() ? "" : " " + options);
+  const std::string fullOptions = "-cl-std=CL1.2" + (options.empty() ? "" : " " + options) +
+                                  (rt.extraBuildOptions.empty() ? "" : " " + rt.extraBuildOptions);
   const cl::Device& device = rt.selected.device;
   const DeviceInfo& info = rt.selected.info;
 
@@ -176,9 +219,9 @@ cl::Program buildProgram(ClRuntime& rt, const std::string& kernelFile, const std
     std::string log;
     for (const auto& deviceLog : e.getBuildLog()) log += deviceLog.second;
     if (log.empty()) log = buildLog(program, device);
-    throwBuildError(kernelFile, e, log);
+    throwBuildError(kernelFile, e, log, source);
   } catch (const cl::Error& e) {
-    throwBuildError(kernelFile, e, buildLog(program, device));
+    throwBuildError(kernelFile, e, buildLog(program, device), source);
   }
 
   if (!entry.empty()) {

@@ -86,18 +86,24 @@ std::unique_ptr<Imf::InputFile> openExr(const std::string& path) {
 }  // namespace
 
 void writeExr(const std::string& path, const ImageRGB& image,
-              const std::vector<std::pair<std::string, std::string>>& attributes) {
+              const std::vector<std::pair<std::string, std::string>>& attributes,
+              const std::vector<ExrChannel>& extra) {
   if (image.width <= 0 || image.height <= 0)
     throw std::runtime_error(writeErrorMessage(path, "empty image (" + std::to_string(image.width) + "x" +
                                                          std::to_string(image.height) + ")"));
   if (image.rgb.size() != size_t(image.width) * size_t(image.height) * 3)
     throw std::runtime_error(writeErrorMessage(path, "pixel buffer size does not match the image size"));
+  const size_t pixels = size_t(image.width) * size_t(image.height);
+  for (const ExrChannel& c : extra)
+    if (c.values.size() != pixels)
+      throw std::runtime_error(writeErrorMessage(path, "channel " + c.name + " does not match the image size"));
 
   Imf::Header header(image.width, image.height);
   header.compression() = Imf::ZIP_COMPRESSION;
   header.channels().insert("R", Imf::Channel(Imf::FLOAT));
   header.channels().insert("G", Imf::Channel(Imf::FLOAT));
   header.channels().insert("B", Imf::Channel(Imf::FLOAT));
+  for (const ExrChannel& c : extra) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
   for (const auto& [name, value] : attributes) {
     try {
       header.insert(name, Imf::StringAttribute(value));
@@ -117,6 +123,9 @@ void writeExr(const std::string& path, const ImageRGB& image,
     frame.insert("R", Imf::Slice(Imf::FLOAT, base + 0 * sizeof(float), xStride, yStride));
     frame.insert("G", Imf::Slice(Imf::FLOAT, base + 1 * sizeof(float), xStride, yStride));
     frame.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xStride, yStride));
+    for (const ExrChannel& c : extra)
+      frame.insert(c.name, Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(c.values.data())),
+                                      sizeof(float), sizeof(float) * size_t(image.width)));
     file.setFrameBuffer(frame);
     file.writePixels(image.height);
   } catch (const std::exception& e) {
@@ -126,44 +135,68 @@ void writeExr(const std::string& path, const ImageRGB& image,
   out.commit();
 }
 
-ImageRGB readExr(const std::string& path) {
-  auto file = openExr(path);
-  const Imf::Header& header = file->header();
-  for (const char* name : {"R", "G", "B"}) {
+namespace {
+
+// Reads the channels `names` (each must exist) as FLOAT into `out`, interleaved (names.size() floats
+// per pixel, in that order); *width and *height are the data window's size.
+void readChannels(const std::string& path, Imf::InputFile& file, const std::vector<std::string>& names,
+                  std::vector<float>& out, int* width, int* height) {
+  const Imf::Header& header = file.header();
+  for (const std::string& name : names) {
     if (!header.channels().findChannel(name)) {
       std::string found;
       for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
         found += (found.empty() ? "" : ", ") + std::string(it.name());
-      throw inputError(path, "", std::string("no ") + name + " channel (channels: " +
-                                     (found.empty() ? "none" : found) + ")");
+      throw inputError(path, "", "no " + name + " channel (channels: " + (found.empty() ? "none" : found) + ")");
     }
   }
   const Imath::Box2i window = header.dataWindow();
-  const int64_t width = int64_t(window.max.x) - window.min.x + 1;
-  const int64_t height = int64_t(window.max.y) - window.min.y + 1;
-  if (width <= 0 || height <= 0) throw inputError(path, "", "empty data window");
-  if (width * height > (int64_t(1) << 28))
-    throw inputError(path, "", "image too large (" + std::to_string(width) + "x" + std::to_string(height) + ")");
-
-  ImageRGB image;
-  image.width = int(width);
-  image.height = int(height);
-  image.rgb.assign(size_t(width * height) * 3, 0.0f);
-  const size_t xStride = 3 * sizeof(float);
-  const size_t yStride = xStride * size_t(width);
-  char* base = reinterpret_cast<char*>(image.rgb.data());
+  const int64_t w = int64_t(window.max.x) - window.min.x + 1;
+  const int64_t h = int64_t(window.max.y) - window.min.y + 1;
+  if (w <= 0 || h <= 0) throw inputError(path, "", "empty data window");
+  if (w * h > (int64_t(1) << 28))
+    throw inputError(path, "", "image too large (" + std::to_string(w) + "x" + std::to_string(h) + ")");
+  *width = int(w);
+  *height = int(h);
+  const size_t stride = names.size();
+  out.assign(size_t(w * h) * stride, 0.0f);
+  const size_t xStride = stride * sizeof(float);
+  const size_t yStride = xStride * size_t(w);
+  char* base = reinterpret_cast<char*>(out.data());
   Imf::FrameBuffer frame;
   // Slice::Make offsets the base pointer by the data window origin without overflow.
-  frame.insert("R", Imf::Slice::Make(Imf::FLOAT, base + 0 * sizeof(float), window, xStride, yStride));
-  frame.insert("G", Imf::Slice::Make(Imf::FLOAT, base + 1 * sizeof(float), window, xStride, yStride));
-  frame.insert("B", Imf::Slice::Make(Imf::FLOAT, base + 2 * sizeof(float), window, xStride, yStride));
+  for (size_t i = 0; i < names.size(); ++i)
+    frame.insert(names[i], Imf::Slice::Make(Imf::FLOAT, base + i * sizeof(float), window, xStride, yStride));
   try {
-    file->setFrameBuffer(frame);
-    file->readPixels(window.min.y, window.max.y);
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
   } catch (const std::exception& e) {
     throw inputError(path, "", "corrupt OpenEXR file: " + oneLine(e.what()));
   }
+}
+
+}  // namespace
+
+ImageRGB readExr(const std::string& path) {
+  auto file = openExr(path);
+  ImageRGB image;
+  readChannels(path, *file, {"R", "G", "B"}, image.rgb, &image.width, &image.height);
   return image;
+}
+
+std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names) {
+  auto file = openExr(path);
+  std::vector<float> interleaved;
+  int width = 0, height = 0;
+  readChannels(path, *file, names, interleaved, &width, &height);
+  const size_t pixels = size_t(width) * size_t(height), n = names.size();
+  std::vector<ExrChannel> channels(n);
+  for (size_t c = 0; c < n; ++c) {
+    channels[c].name = names[c];
+    channels[c].values.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) channels[c].values[i] = interleaved[i * n + c];
+  }
+  return channels;
 }
 
 std::map<std::string, std::string> readExrAttributes(const std::string& path) {

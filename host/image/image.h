@@ -17,11 +17,19 @@ struct ImageRGB {
   const float* pixel(int x, int y) const { return &rgb[(size_t(y) * width + x) * 3]; }
 };
 
-// 32-bit float linear RGB EXR; `attributes` become string attributes in the header (spp, seed...).
+// A named 32-bit float channel of width*height values, row 0 at the top (e.g. "accum_sum.R").
+struct ExrChannel {
+  std::string name;
+  std::vector<float> values;
+};
+
+// 32-bit float linear RGB EXR; `attributes` become string attributes in the header (spp, seed...);
+// `extra` channels are stored beside R, G and B (viewers show them as layers).
 // Written to a temporary file beside `path` and renamed, so a failure never leaves a broken file
 // and never touches an existing `path`; it throws std::runtime_error "PATH: cannot write: REASON".
 void writeExr(const std::string& path, const ImageRGB& image,
-              const std::vector<std::pair<std::string, std::string>>& attributes = {});
+              const std::vector<std::pair<std::string, std::string>>& attributes = {},
+              const std::vector<ExrChannel>& extra = {});
 // Reads R, G and B as 32-bit float (half or uint channels are converted) from any data window;
 // the result is the data window's size. A missing, unreadable or corrupt file, or a missing R, G or
 // B channel, throws InputError "PATH: what".
@@ -29,6 +37,9 @@ ImageRGB readExr(const std::string& path);
 // The string attributes of an EXR header (what writeExr's `attributes` put there), by name;
 // throws InputError like readExr.
 std::map<std::string, std::string> readExrAttributes(const std::string& path);
+// The named channels as 32-bit float, width*height values each in the data window's size; a
+// missing channel throws InputError "PATH: no NAME channel (channels: ...)", like readExr.
+std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names);
 
 // 8-bit RGB pictures (display images, figures); row 0 at the top.
 struct ImageRGB8 {

@@ -9,13 +9,17 @@
 namespace narval {
 
 struct DeviceSceneBuffers {
-  DeviceScene scene;
+  DeviceScene scene;  // buildOptions include the grid storage's -D option
+  // renderer.storage resolved for the device (resolveGridStorage): what the kernels are built
+  // for and the grid is uploaded as. Without a grid neither is used (MEDIUM_HOMOGENEOUS).
+  GridStorage storage = GridStorage::Image;
   cl::Buffer sceneBuf, lightBuf, majorantBuf;
-  cl::Image3D gridImage;  // empty for a homogeneous medium or none
+  cl::Image3D gridImage;  // the grid with image storage; empty otherwise
+  cl::Buffer gridBuffer;  // the grid with buffer storage; empty otherwise
 
   DeviceSceneBuffers(ClRuntime& rt, const Scene& s, const DenseGrid* grid);
-  // Sets kernel arguments 0 (scene), 1 (lights), 2 (grid image, or an unused int) and 3 (majorant
-  // cells); kernel-specific arguments start at kFirstFreeArg.
+  // Sets kernel arguments 0 (scene), 1 (lights), 2 (grid image or buffer, or an unused int) and
+  // 3 (majorant cells); kernel-specific arguments start at kFirstFreeArg.
   void bind(cl::Kernel& kernel) const;
   static constexpr cl_uint kFirstFreeArg = 4;
 };

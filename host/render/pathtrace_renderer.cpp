@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
+#include "render/device_allocation.h"
 #include "render/device_scene.h"
+#include "render/majorant_options.h"
 #include "render/render_common.h"
 
 namespace narval {
@@ -26,43 +29,72 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
                              const RenderOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const int W = scene.renderer.width, H = scene.renderer.height, spp = scene.renderer.spp;
-  const DeviceSceneBuffers dev(rt, scene, grid);
+  checkMajorantOptions(options);
+  DeviceSceneBuffers dev(rt, scene, grid);
+  const size_t pixels = size_t(W) * size_t(H), accumBytes = pixels * 4 * sizeof(float);
+  const AccumulatorState* resume = options.resumeFrom;
+  if (resume && (resume->sum.size() != pixels * 4 || resume->comp.size() != pixels * 4 || resume->samples > spp))
+    throw std::invalid_argument("renderPathtrace: the state to resume from does not fit this render");
 
   RenderResult result;
   result.warnings = dev.scene.warnings;
   result.stats = initialStats("pathtrace", rt, scene);
   RenderStats& st = result.stats;
+  st.majorant = options.majorant;
+  st.counters = options.counters;
+  applyMajorantResolution(rt, dev, options, st);
 
-  cl::Program program = buildProgram(rt, "pathtrace.cl", dev.scene.buildOptions, nullptr, &st.programFromCache);
+  cl::Program program = buildProgram(rt, "pathtrace.cl",
+                                     joinBuildOptions(dev.scene.buildOptions, pathtraceMajorantBuildOptions(options)),
+                                     nullptr, &st.programFromCache);
   cl::Kernel kernel(program, "pathtrace");
 
-  const size_t pixels = size_t(W) * size_t(H);
-  cl::Buffer sumBuf(rt.context, CL_MEM_READ_WRITE, pixels * 4 * sizeof(float));
-  cl::Buffer compBuf(rt.context, CL_MEM_READ_WRITE, pixels * 4 * sizeof(float));
+  const AllocationSite site{scene.sourcePath, "renderer.resolution",
+                            "an accumulator of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
+  cl::Buffer sumBuf = allocateBuffer(rt, CL_MEM_READ_WRITE, accumBytes, site);
+  cl::Buffer compBuf = allocateBuffer(rt, CL_MEM_READ_WRITE, accumBytes, site);
   cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
-  rt.queue.enqueueFillBuffer(sumBuf, 0.0f, 0, pixels * 4 * sizeof(float));
-  rt.queue.enqueueFillBuffer(compBuf, 0.0f, 0, pixels * 4 * sizeof(float));
-  rt.queue.enqueueFillBuffer(statusBuf, cl_uint(0), 0, sizeof(cl_uint));
+  if (resume) {
+    rt.queue.enqueueWriteBuffer(sumBuf, CL_FALSE, 0, accumBytes, resume->sum.data());
+    rt.queue.enqueueWriteBuffer(compBuf, CL_FALSE, 0, accumBytes, resume->comp.data());
+  } else {
+    rt.queue.enqueueFillBuffer(sumBuf, 0.0f, 0, accumBytes);
+    rt.queue.enqueueFillBuffer(compBuf, 0.0f, 0, accumBytes);
+  }
+  rt.queue.enqueueFillBuffer(statusBuf, cl_uint(resume ? resume->status : 0u), 0, sizeof(cl_uint));
   dev.bind(kernel);
   const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
   kernel.setArg(arg + 0, sumBuf);
   kernel.setArg(arg + 1, compBuf);
   kernel.setArg(arg + 4, statusBuf);
+  // -DCOUNTERS: three ulongs per pixel, each work-item adding to its own (pathtrace.cl).
+  const size_t counterBytes = options.counters ? pixels * 3 * sizeof(cl_ulong) : 0;
+  cl::Buffer counterBuf;
+  if (options.counters) {
+    counterBuf = allocateBuffer(rt, CL_MEM_READ_WRITE, counterBytes,
+                                {scene.sourcePath, "renderer.resolution",
+                                 "collision counters of " + std::to_string(W) + "x" + std::to_string(H) + " pixels"});
+    rt.queue.enqueueFillBuffer(counterBuf, cl_ulong(0), 0, counterBytes);
+    kernel.setArg(arg + 5, counterBuf);
+  }
   rt.queue.finish();
   st.buildSeconds = secondsSince(t0);
 
   const cl::NDRange global = paddedGlobalRange(W, H, options), local = localRange(options);
+  const size_t deviceBytes = deviceSceneBytes(dev.scene) + 2 * accumBytes + counterBytes;
   const int perPass = options.samplesPerPass > 0 ? options.samplesPerPass : pathtraceSamplesPerPass(W, H, spp);
+  const int first = resume ? resume->samples : 0;
   std::vector<double> kernelMs, wallMs;  // per pass: with one sample per pass, per frame
   const auto tLoop = std::chrono::steady_clock::now();
-  for (int done = 0; done < spp;) {
+  int done = first;
+  // Samples [done, done + count) per pass; the kernel adds them in index order, so any split of
+  // the same samples (passes, interruption and --resume) gives the same bits.
+  while (done < spp && !cancelled(options)) {
     const int count = std::min(perPass, spp - done);
     kernel.setArg(arg + 2, cl_uint(done));
     kernel.setArg(arg + 3, cl_uint(count));
     const auto tPass = std::chrono::steady_clock::now();
-    cl::Event ev;
-    rt.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &ev);
-    ev.wait();
+    const cl::Event ev = launchAndWait(rt, kernel, global, local, "pathtrace", deviceBytes);
     wallMs.push_back(secondsSince(tPass) * 1e3);
     kernelMs.push_back(eventSeconds(ev) * 1e3);
     st.kernelSeconds += kernelMs.back() * 1e-3;
@@ -70,14 +102,32 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
     ++st.passes;
     if (options.progress) options.progress(done, spp);
   }
-  std::vector<float> sums(pixels * 4);
-  rt.queue.enqueueReadBuffer(sumBuf, CL_TRUE, 0, sums.size() * sizeof(float), sums.data());
+  AccumulatorState& acc = result.accumulator;
+  acc.samples = done;
+  acc.sum.resize(pixels * 4);
+  acc.comp.resize(pixels * 4);
+  rt.queue.enqueueReadBuffer(sumBuf, CL_TRUE, 0, accumBytes, acc.sum.data());
+  rt.queue.enqueueReadBuffer(compBuf, CL_TRUE, 0, accumBytes, acc.comp.data());
   rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &st.status);
+  acc.status = st.status;
+  if (options.counters) {
+    std::vector<cl_ulong> counts(pixels * 3);
+    rt.queue.enqueueReadBuffer(counterBuf, CL_TRUE, 0, counterBytes, counts.data());
+    for (size_t i = 0; i < pixels; ++i) {
+      st.collisionsTentative += counts[3 * i + 0];
+      st.collisionsReal += counts[3 * i + 1];
+      st.densityLookups += counts[3 * i + 2];
+    }
+  }
   st.seconds = secondsSince(tLoop);
   st.frames = frameTimings(kernelMs, wallMs);
-  st.samplesPerSecond = st.seconds > 0 ? double(pixels) * spp / st.seconds : 0.0;
+  st.spp = done;
+  st.sppRequested = spp;
+  st.resumedFromSpp = first;
+  st.interrupted = done < spp;
+  st.samplesPerSecond = st.seconds > 0 ? double(pixels) * (done - first) / st.seconds : 0.0;
 
-  result.image = imageFromRgba(sums, W, H, float(spp), &st.nanPixels);
+  if (done > 0) result.image = imageFromRgba(acc.sum, W, H, float(done), &st.nanPixels);
   return result;
 }
 

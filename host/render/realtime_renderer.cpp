@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 
+#include "render/device_allocation.h"
 #include "render/device_scene.h"
 #include "render/lobe_directions.h"
+#include "render/majorant_options.h"
 #include "render/render_common.h"
 #include "scene/input_error.h"
 
@@ -33,13 +35,16 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
     throw std::invalid_argument("renderRealtime: not a real-time algorithm: " + algorithm);
   const auto t0 = std::chrono::steady_clock::now();
   const int W = scene.renderer.width, H = scene.renderer.height;
-  const DeviceSceneBuffers dev(rt, scene, grid);
+  checkMajorantOptions(options);
+  DeviceSceneBuffers dev(rt, scene, grid);
 
   RenderResult result;
   result.warnings = dev.scene.warnings;
   result.stats = initialStats(algorithm, rt, scene);
   RenderStats& st = result.stats;
-  st.spp = 1;
+  st.majorant = "grid";  // the marches always skip empty cells (march.h); options.majorant is the path tracer's
+  applyMajorantResolution(rt, dev, options, st);
+  st.spp = st.sppRequested = 1;
 
   const realtime_params params = realtimeParams(scene);
   const scene_params& sp = dev.scene.params;
@@ -53,7 +58,9 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   cl::Buffer paramBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(params),
                       const_cast<realtime_params*>(&params));
   cl::Buffer dirBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4), dirs.data());
-  cl::Buffer outBuf(rt.context, CL_MEM_WRITE_ONLY, pixels * 4 * sizeof(float));
+  const AllocationSite site{scene.sourcePath, "renderer.resolution",
+                            "an image of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
+  cl::Buffer outBuf = allocateBuffer(rt, CL_MEM_WRITE_ONLY, pixels * 4 * sizeof(float), site);
   cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
   rt.queue.enqueueFillBuffer(statusBuf, cl_uint(0), 0, sizeof(cl_uint));
   dev.bind(kernel);
@@ -67,15 +74,21 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
 
   // One launch per frame, each timed by its profiling event and by the wall clock around it.
   const cl::NDRange global = paddedGlobalRange(W, H, options), local = localRange(options);
+  const size_t deviceBytes = deviceSceneBytes(dev.scene) + pixels * 4 * sizeof(float) + sizeof(params) +
+                             dirs.size() * sizeof(nv_float4);
+  const int requested = std::max(1, frames);
   std::vector<double> kernelMs, wallMs;
-  for (int f = 0; f < std::max(1, frames); ++f) {
+  for (int f = 0; f < requested && !cancelled(options); ++f) {
     const auto tf = std::chrono::steady_clock::now();
-    cl::Event ev;
-    rt.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &ev);
-    ev.wait();
+    const cl::Event ev = launchAndWait(rt, kernel, global, local, algorithm, deviceBytes);
     wallMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tf).count());
     kernelMs.push_back(eventSeconds(ev) * 1e3);
-    if (options.progress) options.progress(f + 1, std::max(1, frames));
+    if (options.progress) options.progress(f + 1, requested);
+  }
+  st.interrupted = int(kernelMs.size()) < requested;
+  if (kernelMs.empty()) {
+    st.spp = 0;
+    return result;
   }
   std::vector<float> rgba(pixels * 4);
   rt.queue.enqueueReadBuffer(outBuf, CL_TRUE, 0, rgba.size() * sizeof(float), rgba.data());

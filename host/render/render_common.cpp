@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/device_allocation.h"
+#include "render/device_grid.h"
+
 namespace narval {
 
 RenderStats initialStats(const std::string& algorithm, const ClRuntime& rt, const Scene& scene) {
@@ -11,8 +14,9 @@ RenderStats initialStats(const std::string& algorithm, const ClRuntime& rt, cons
   st.device = rt.selected.info.name;
   st.width = scene.renderer.width;
   st.height = scene.renderer.height;
-  st.spp = scene.renderer.spp;
+  st.spp = st.sppRequested = scene.renderer.spp;
   st.bounces = scene.renderer.bounces;
+  st.storage = gridStorageName(resolveGridStorage(scene.renderer.storage, rt.selected.info));
   return st;
 }
 
@@ -69,5 +73,37 @@ double eventSeconds(const cl::Event& e) {
   return double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
          1e-9;
 }
+
+size_t deviceSceneBytes(const DeviceScene& scene) {
+  return sizeof(scene_params) + scene.lights.size() * sizeof(light_params) + scene.majorants.size() * sizeof(float) +
+         (scene.grid ? scene.grid->voxelCount() * sizeof(float) : 0);
+}
+
+cl::Event launchAndWait(ClRuntime& rt, const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local,
+                        const std::string& what, size_t deviceBytes) {
+  cl::Event ev;
+  try {
+    rt.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &ev);
+    ev.wait();
+  } catch (const cl::Error& e) {
+    // A launch that failed while running reports its own error as the event's (negative) status.
+    cl_int status = 0;
+    if (e.err() == CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST &&
+        ev.getInfo(CL_EVENT_COMMAND_EXECUTION_STATUS, &status) == CL_SUCCESS && status < 0)
+      rethrowLaunchError(cl::Error(status, "kernel execution"), rt.selected.info, what, deviceBytes);
+    rethrowLaunchError(e, rt.selected.info, what, deviceBytes);
+  }
+  return ev;
+}
+
+std::vector<std::string> statusWarnings(uint32_t status) {
+  std::vector<std::string> w;
+  if (status & STATUS_NAN) w.push_back("the kernel produced non-finite samples (dropped)");
+  if (status & STATUS_NEGATIVE_PDF) w.push_back("the kernel met a non-positive pdf");
+  if (status & STATUS_ITERATION_CAP) w.push_back("a loop hit its iteration cap (tracking walk or majorant DDA)");
+  return w;
+}
+
+bool cancelled(const RenderOptions& options) { return options.cancel && options.cancel->load(); }
 
 }  // namespace narval

@@ -6,6 +6,7 @@
 
 #include "cl/cl_runtime.h"
 #include "render/render_types.h"
+#include "render/scene_upload.h"
 #include "scene/scene.h"
 
 namespace narval {
@@ -26,5 +27,19 @@ FrameTimings frameTimings(const std::vector<double>& kernelMs, const std::vector
 
 // Seconds between an event's start and end (profiling queue).
 double eventSeconds(const cl::Event& e);
+
+// Device memory a scene holds once uploaded (scene, lights, majorant cells, grid), in bytes.
+size_t deviceSceneBytes(const DeviceScene& scene);
+
+// One launch of `kernel`, waited for; a resource error names `what` and the `deviceBytes` this render
+// holds (rethrowLaunchError). Returns the launch's profiling event.
+cl::Event launchAndWait(ClRuntime& rt, const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local,
+                        const std::string& what, size_t deviceBytes);
+
+// One warning line per STATUS_* bit set in `status` (what the kernels met; DESIGN.md).
+std::vector<std::string> statusWarnings(uint32_t status);
+
+// True once options.cancel is set (Ctrl-C): the render loops stop before their next pass.
+bool cancelled(const RenderOptions& options);
 
 }  // namespace narval

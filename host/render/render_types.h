@@ -1,6 +1,7 @@
 // render_types.h: what every renderer takes (options) and gives back (image + statistics).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -10,11 +11,33 @@
 
 namespace narval {
 
+// The path tracer's per-pixel compensated sums after `samples` samples per pixel: sum and
+// compensation, RGBA as the kernel keeps them (width*height*4 each). The kernel adds samples in
+// index order to this state, so continuing from it gives the bits of an uninterrupted render.
+struct AccumulatorState {
+  int samples = 0;
+  uint32_t status = 0;  // STATUS_* bits met so far
+  std::vector<float> sum, comp;
+};
+
 struct RenderOptions {
   int localSizeX = 8, localSizeY = 8;  // work-group shape; never changes the pixels
   int samplesPerPass = 0;              // pathtrace: 0 = automatic (pathtraceSamplesPerPass)
   // Called after every pass with (samples done, samples requested) per pixel.
   std::function<void(int, int)> progress;
+  // Checked before every pass (frame): once true, the render stops and returns what it has.
+  const std::atomic<bool>* cancel = nullptr;
+  // pathtrace: continue from this state (same scene, size and seed) instead of from zero.
+  const AccumulatorState* resumeFrom = nullptr;
+  // pathtrace: the majorant delta and ratio tracking sample against (kernels/shared/tracking.h):
+  // "grid" (per cell of the majorant grid, walked by DDA) or "global" (one σ̄ over the box). Each is
+  // its own kernel build; both are unbiased and deterministic, with different random streams.
+  std::string majorant = "grid";
+  // Majorant grid cells along the grid's longest axis (chooseMajorantResolution); 0 = automatic.
+  // Also the real-time kernels' empty-space skipping granularity.
+  int majorantResolution = 0;
+  // pathtrace: build with -DCOUNTERS and report collision and lookup counts in RenderStats.
+  bool counters = false;
 };
 
 // Per-frame timings of a --frames run. The first frame (program build on first launch, warm-up)
@@ -28,20 +51,38 @@ struct FrameTimings {
 
 struct RenderStats {
   std::string algorithm, device;
-  int width = 0, height = 0, spp = 0, bounces = 0;
+  // Grid storage the kernels were built for, "image" or "buffer": renderer.storage resolved for the
+  // device (resolveGridStorage, as DeviceSceneBuffers::storage); shown even when the medium has no
+  // grid to store.
+  std::string storage;
+  int width = 0, height = 0, bounces = 0;
+  int spp = 0;                 // samples per pixel in the image (pathtrace: resumed ones included)
+  int sppRequested = 0;        // what the scene asked for; more than spp when interrupted
+  int resumedFromSpp = 0;      // pathtrace --resume: samples per pixel the render started from
+  bool interrupted = false;    // stopped by RenderOptions::cancel before the requested samples
   double seconds = 0;          // wall clock of the sample loop (after build and upload)
   double kernelSeconds = 0;    // sum of OpenCL profiling intervals of the launches
   double buildSeconds = 0;     // program build (or cache load) and upload
   double samplesPerSecond = 0; // width·height·spp / seconds
-  int passes = 0;
+  int passes = 0;              // launches in this run (frames for the real-time algorithms)
   uint32_t status = 0;         // OR of STATUS_* bits reported by the kernels
   long long nanPixels = 0;     // non-finite pixels in the final image
   bool programFromCache = false;
   FrameTimings frames;         // filled by frame-timed runs (--frames)
+  // Majorant of the path tracer's tracking ("grid" or "global"; the real-time kernels always skip
+  // with the grid) and the majorant grid's cells per axis (0 0 0 without a grid).
+  std::string majorant;
+  int majorantCells[3] = {0, 0, 0};
+  // RenderOptions::counters (pathtrace): sums over all pixels of this run's samples (not those of a
+  // resumed state): delta/spectral-tracking tentative collisions, real (absorbing or scattering)
+  // collisions, density lookups of delta and ratio tracking (kernels/shared/tracking.h).
+  bool counters = false;
+  uint64_t collisionsTentative = 0, collisionsReal = 0, densityLookups = 0;
 };
 
 struct RenderResult {
-  ImageRGB image;
+  ImageRGB image;               // empty when interrupted before the first pass
+  AccumulatorState accumulator; // pathtrace only
   RenderStats stats;
   std::vector<std::string> warnings;  // from preparing the scene for the device
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "scene/input_error.h"
 #include "volume/majorant_grid.h"
@@ -223,6 +224,19 @@ DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
   if (ds.lights.empty()) ds.lights.push_back(light_params{});  // a buffer may not be empty
   ds.buildOptions = (!sp.has_medium || !grid) ? "-DMEDIUM_HOMOGENEOUS" : "";
   return ds;
+}
+
+bool setMajorantResolution(DeviceScene& ds, int target) {
+  if (target < 0) throw std::invalid_argument("setMajorantResolution: negative target " + std::to_string(target));
+  if (target == 0 || !ds.grid || !ds.params.has_medium) return false;
+  const DenseGrid& g = *ds.grid;
+  const std::array<int, 3> cells = chooseMajorantResolution(g.nx, g.ny, g.nz, target);
+  const majorant_grid_params& now = ds.params.medium.majorant_grid;
+  if (cells[0] == now.cells_x && cells[1] == now.cells_y && cells[2] == now.cells_z) return false;
+  MajorantGrid mg = buildMajorantGrid(g, cells[0], cells[1], cells[2]);
+  ds.params.medium.majorant_grid = mg.params();
+  ds.majorants = std::move(mg.maxDensity);
+  return true;
 }
 
 }  // namespace narval

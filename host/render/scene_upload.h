@@ -33,4 +33,10 @@ nv_affine affineInverse(const nv_affine& m);
 // Throws InputError for geometry the renderer cannot use (a singular volume transform).
 DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid);
 
+// Rebuilds the majorant grid of `ds` (its cells and medium.majorant_grid) with about `target` cells
+// along the grid's longest axis (chooseMajorantResolution); target 0 keeps the automatic choice
+// buildDeviceScene made. No-op without a grid (homogeneous or no medium: one cell). Returns whether
+// the cells changed. Throws std::invalid_argument for a negative target.
+bool setMajorantResolution(DeviceScene& ds, int target);
+
 }  // namespace narval

@@ -11,9 +11,21 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// "FILE: KEY: message" (KEY omitted when empty): the one shape every input error has.
+// "FILE: KEY: message" (KEY omitted when empty): the one shape every input error has. Always one
+// line: control characters that came from the input (a newline in a JSON string or a file name)
+// are written as escapes, \n \r \t or \xHH.
 inline InputError inputError(const std::string& file, const std::string& key, const std::string& what) {
-  return InputError(key.empty() ? file + ": " + what : file + ": " + key + ": " + what);
+  const std::string line = key.empty() ? file + ": " + what : file + ": " + key + ": " + what;
+  std::string out;
+  for (const char c : line) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u != 0x7f) out += c;
+    else if (c == '\n') out += "\\n";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\t') out += "\\t";
+    else out += std::string{'\\', 'x', "0123456789abcdef"[u >> 4], "0123456789abcdef"[u & 15]};
+  }
+  return InputError(out);
 }
 
 }  // namespace narval

@@ -47,6 +47,8 @@
 // |   exposure              | number, stops                   |     | 0           |                            |
 // |   algorithm             | pathtrace, raymarch, lobe       |     | pathtrace   |                            |
 // |   seed                  | integer                         |     | 0           | [0, 2^32 - 1]              |
+// |   storage               | auto, image, buffer: the grid   |     | auto        | auto: buffer on CPU        |
+// |                         | on the device (--storage)       |     |             | devices, image elsewhere   |
 // |   raymarch.steps        | integer                         |     | 60          | >= 1                       |
 // |   raymarch.shadowSteps  | integer                         |     | 10          | >= 1                       |
 // |   raymarch.octaves      | integer                         |     | 1           | [1, 16]; 1 = off           |
@@ -81,6 +83,7 @@ namespace {
 
 constexpr int64_t kIntMax = std::numeric_limits<int>::max();
 constexpr int64_t kMaxImageSide = 16384;  // keeps width * height well inside an int
+constexpr int kMaxJsonDepth = 128;       // nesting levels of the JSON (a scene needs 5)
 
 template <typename E>
 using EnumNames = std::vector<std::pair<const char*, E>>;
@@ -122,6 +125,9 @@ const EnumNames<PrimitiveType> kPrimitiveTypes = {{"rectangle", PrimitiveType::R
 const EnumNames<ToneMapping> kToneMappings = {{"none", ToneMapping::None},
                                               {"reinhard", ToneMapping::Reinhard},
                                               {"aces", ToneMapping::Aces}};
+const EnumNames<GridStorage> kGridStorages = {{"auto", GridStorage::Auto},
+                                              {"image", GridStorage::Image},
+                                              {"buffer", GridStorage::Buffer}};
 const EnumNames<std::string> kAlgorithms = {{"pathtrace", "pathtrace"},
                                             {"raymarch", "raymarch"},
                                             {"lobe", "lobe"}};
@@ -294,6 +300,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
   s.toneMapping = readToneMapping(r, s.toneMapping);
   s.exposure = r.getFloat("exposure", s.exposure);
   s.algorithm = readEnum(r, "algorithm", kAlgorithms, s.algorithm);
+  s.storage = readEnum(r, "storage", kGridStorages, s.storage);
   s.seed = static_cast<uint32_t>(checkIntRange(ctx, r.keyOf("seed"), r.getInteger("seed", s.seed), 0,
                                                std::numeric_limits<uint32_t>::max()));
   if (const json* v = r.find("raymarch")) {
@@ -391,7 +398,13 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
 
   json doc;
   try {
-    doc = json::parse(jsonText);
+    // Scenes nest 5 levels (primitives[i].transform.position[j]). nlohmann's copy and dump recurse
+    // once per level, so a document nested thousands deep would overflow the stack later on.
+    doc = json::parse(jsonText, [&ctx](int depth, json::parse_event_t, json&) {
+      if (depth > kMaxJsonDepth)
+        ctx.fail("", "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels (a scene needs 5)");
+      return true;
+    });
   } catch (const json::exception& e) {  // parse_error, and out_of_range for 1e999
     ctx.fail("", "invalid JSON: " + parseMessage(e));
   }
@@ -400,6 +413,7 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
   std::vector<std::pair<std::string, std::string>> overridden;  // (as written, loader key)
   for (const std::string& spec : overrides)
     overridden.emplace_back(spec.substr(0, spec.find('=')), applyOverride(doc, spec, path));
+  scene.document = doc;
 
   ObjectReader root(ctx, doc, "");
   readMaterials(ctx, root, scene);
@@ -436,6 +450,12 @@ const char* toneMappingName(ToneMapping t) {
     case ToneMapping::Aces: return "aces";
   }
   return "none";
+}
+
+const char* gridStorageName(GridStorage s) {
+  for (const auto& [name, value] : kGridStorages)
+    if (value == s) return name;
+  return "auto";
 }
 
 }  // namespace narval

@@ -14,6 +14,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+constexpr size_t kMaxPathLength = 4096;
+
 bool isNameChar(char c, bool first) {
   return c == '_' || std::isalpha(static_cast<unsigned char>(c)) ||
          (!first && std::isdigit(static_cast<unsigned char>(c)));
@@ -71,6 +73,11 @@ std::string expandEnvironment(const std::string& text, const std::string& file, 
 std::string resolveVolumePath(const std::string& raw, const std::string& sceneFile,
                               const std::string& key) {
   if (raw.empty()) throw inputError(sceneFile, key, "must not be empty (leave it out for a homogeneous medium)");
+  // No file name is longer (PATH_MAX), and expanding a long chain of nested ${...} costs time and
+  // memory quadratic in its length.
+  if (raw.size() > kMaxPathLength)
+    throw inputError(sceneFile, key, "must be at most " + std::to_string(kMaxPathLength) +
+                                         " characters long, got " + std::to_string(raw.size()));
   fs::path p = expandEnvironment(raw, sceneFile, key);
   // Relative to the scene file, not the working directory, so scenes can be run from anywhere.
   if (p.is_relative()) p = fs::absolute(fs::path(sceneFile)).parent_path() / p;

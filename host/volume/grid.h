@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,11 @@ struct DenseGrid {
 DenseGrid loadGrid(const std::string& path, const std::string& gridName = "density");
 DenseGrid loadVdb(const std::string& path, const std::string& gridName);
 DenseGrid loadVol(const std::string& path);
+// The .vol text from a seekable stream positioned at its start (loadVol is this on the opened
+// file); `path` names it in messages and becomes DenseGrid::source. Throws InputError as loadVol.
+// The input is read `chunkBytes` at a time (never more than its size); a token as long as a chunk
+// is not a number. Tests and the fuzzer pass small chunks to exercise the chunk boundaries.
+DenseGrid parseVol(std::istream& in, const std::string& path, size_t chunkBytes = size_t(1) << 20);
 
 // loadVdb and vdbGridNames read the file in a forked child process on Linux (OpenVDB 10's reader
 // aborts or corrupts memory on some corrupt files; the child's death becomes an InputError here).

@@ -37,9 +37,13 @@ void majorantVoxelRange(double cellMin, double cellMax, int n, int* lo, int* hi)
 // than one cell on an axis, or data that does not match the dims.
 MajorantGrid buildMajorantGrid(const DenseGrid& density, int cellsX, int cellsY, int cellsZ);
 
+// The automatic majorant grid resolution: cells along the grid's longest axis (chosen by
+// measurement, bench/majorant.sh).
+constexpr int kDefaultMajorantResolution = 16;
+
 // About `target` cells along the grid's longest axis and the same cell edge (rounded) along the
 // others: max(1, min(n_i, round(target · n_i / max n))). For the Disney cloud (126×86×154) and 16:
 // 13×9×16. Throws std::invalid_argument for non-positive dims or target.
-std::array<int, 3> chooseMajorantResolution(int nx, int ny, int nz, int target = 16);
+std::array<int, 3> chooseMajorantResolution(int nx, int ny, int nz, int target = kDefaultMajorantResolution);
 
 }  // namespace narval

@@ -1,8 +1,9 @@
 // vol_io.cpp: the dissertation's text .vol format, the density rule every grid obeys, and loadGrid.
 //
 // .vol: the first line is "X Y Z" (three positive integers), then X*Y*Z floats, x fastest,
-// separated by any whitespace (any line breaks). The file is read in 1 MiB chunks; the header is
-// checked against limits and the file size before anything is allocated.
+// separated by any whitespace (any line breaks). The input is read in 1 MiB chunks; the header is
+// checked against limits and the input's size before anything is allocated. loadVol opens the file
+// and calls parseVol, which reads any seekable stream (the fuzzer and tests use bytes in memory).
 #include "volume/grid.h"
 
 #include <algorithm>
@@ -11,11 +12,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <istream>
 #include <limits>
-#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,10 +32,10 @@ constexpr uint64_t kMaxVolValues = uint64_t(1) << 30;
 
 inline bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f' || c == '\n'; }
 
-// Whitespace-separated tokens from a file, with the line each starts on, read in chunks.
+// Whitespace-separated tokens from a stream, with the line each starts on, read in chunks.
 class TokenReader {
  public:
-  explicit TokenReader(std::FILE* f) : file_(f), buf_(size_t(1) << 20) {}
+  TokenReader(std::istream& in, size_t bufferBytes) : in_(in), buf_(std::max<size_t>(bufferBytes, 2)) {}
 
   // The next token (valid until the next call); false at the end of the file. A token that fills
   // the whole buffer comes back truncated with tooLong set (it cannot be a number anyway).
@@ -54,9 +55,10 @@ class TokenReader {
         if (eof_) break;
         if (start == 0 && end_ == buf_.size()) {
           tooLong = true;
-          // Skip the rest of the token so the reader stays usable.
-          tok = std::string_view(buf_.data(), std::min<size_t>(end_, 64));
+          // Keep its start for messages, then skip the rest (which refills the buffer over it).
+          cut_.assign(buf_.data(), std::min<size_t>(end_, 64));
           skipRestOfToken();
+          tok = cut_;
           return true;
         }
         const size_t len = pos_ - start;
@@ -83,9 +85,10 @@ class TokenReader {
     return readMore() || end_ > 0;
   }
   bool readMore() {
-    const size_t n = std::fread(buf_.data() + end_, 1, buf_.size() - end_, file_);
+    in_.read(buf_.data() + end_, std::streamsize(buf_.size() - end_));
+    const size_t n = size_t(in_.gcount());
     if (n == 0) {
-      if (std::ferror(file_)) readError_ = true;
+      if (in_.bad()) readError_ = true;
       eof_ = true;
       return false;
     }
@@ -103,8 +106,9 @@ class TokenReader {
     }
   }
 
-  std::FILE* file_;
+  std::istream& in_;
   std::vector<char> buf_;
+  std::string cut_;  // the start of the last token that was too long
   size_t pos_ = 0, end_ = 0;
   bool eof_ = false, readError_ = false;
   int64_t line_ = 1;
@@ -152,10 +156,6 @@ bool parseDim(std::string_view tok, uint64_t& v) {
   return v > 0;
 }
 
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-
 std::string lower(std::string s) {
   for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -195,18 +195,34 @@ DenseGrid loadVol(const std::string& path) {
   const fs::file_status st = fs::status(path, ec);
   if (!fs::exists(st)) throw inputError(path, "", "cannot open the file: no such file");
   if (fs::is_directory(st)) throw inputError(path, "", "cannot open the file: it is a directory");
-  const uintmax_t fileSize = fs::file_size(path, ec);
-  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "rb"));
-  if (!f || ec) throw inputError(path, "", std::string("cannot open the file: ") + std::strerror(errno));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw inputError(path, "", std::string("cannot open the file: ") + std::strerror(errno));
+  return parseVol(in, path);
+}
 
-  TokenReader reader(f.get());
-  std::string_view tok;
-  int64_t line = 0;
-  bool tooLong = false;
+DenseGrid parseVol(std::istream& in, const std::string& path, size_t chunkBytes) {
+  // The size bounds what the header may declare (each value takes at least 2 bytes).
+  const std::istream::pos_type start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::istream::pos_type end = in.tellg();
+  in.seekg(start);
+  if (start == std::istream::pos_type(-1) || end == std::istream::pos_type(-1) || !in)
+    throw inputError(path, "", "cannot read the file: cannot determine its size");
+  const uint64_t fileSize = uint64_t(end - start);
 
   // A UTF-8 byte order mark is skipped.
   char bom[3] = {0, 0, 0};
-  if (std::fread(bom, 1, 3, f.get()) != 3 || std::memcmp(bom, "\xEF\xBB\xBF", 3) != 0) std::rewind(f.get());
+  in.read(bom, 3);
+  if (in.gcount() != 3 || std::memcmp(bom, "\xEF\xBB\xBF", 3) != 0) {
+    in.clear();
+    in.seekg(start);
+  }
+
+  // One byte more than the input: a small file never fills the buffer, so no token is cut short.
+  TokenReader reader(in, size_t(std::min<uint64_t>(chunkBytes, fileSize + 1)));
+  std::string_view tok;
+  int64_t line = 0;
+  bool tooLong = false;
 
   // Header: the tokens on line 1.
   std::vector<std::string> header;  // as shown in messages

@@ -14,6 +14,7 @@
  * device fuses what. */
 #pragma OPENCL FP_CONTRACT OFF
 typedef float3 vec3;
+typedef ulong nv_ulong; /* 64-bit unsigned (counters, tracking.h) */
 #define vec3_make(x, y, z) ((float3)((x), (y), (z)))
 #define nv_sqrt sqrt
 #define nv_exp exp
@@ -34,6 +35,7 @@ typedef float3 vec3;
 #define NV_CONSTANT
 #define NV_PRIVATE
 typedef uint32_t uint;
+typedef uint64_t nv_ulong;
 typedef struct vec3 {
   float x, y, z;
 } vec3;

@@ -42,7 +42,13 @@
  *    channel (0 where σt = 0).
  * No medium, a ray that misses the box (or meets a rectangle light first), or no density > 0 on the
  * segment: L = L_b exactly (march_background). Means divide by n (not multiply by 1/n), so n
- * transmittances of exactly 1 give exactly L_b. */
+ * transmittances of exactly 1 give exactly L_b.
+ * Loops: the first-hit search (`steps` samples, then LOBE_BISECTIONS), n lobe points × (1 + lights)
+ * transmittance marches of shadow_steps samples: all bounded by the scene's parameters; the only
+ * open-ended walk is the DDA under each march, capped by its budget (majorant.h).
+ * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density, phase value or
+ * lobe point met on the way; STATUS_ITERATION_CAP from a DDA walk. No pdf: never
+ * STATUS_NEGATIVE_PDF. */
 #ifndef NARVAL_LOBE_H
 #define NARVAL_LOBE_H
 
@@ -65,11 +71,14 @@ static inline vec3 lobe_view_dir(NV_CONSTANT const camera_params* c, float px, f
  * search samples the occupied cells only (march_iter), then bisects between the last empty sample
  * (or the start of the occupied piece) and the first non-empty one. */
 static inline int lobe_first_hit(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_PRIVATE const medium_segment* seg,
-                                 int steps, NV_PRIVATE float* t_hit) {
+                                 int steps, NV_PRIVATE float* t_hit, NV_PRIVATE uint* status) {
   march_iter it = march_begin(m, GRID_ARG, seg, steps);
+  *status |= it.status;
   float t, lo = seg->t0;
   while (march_next(&it, GRID_ARG, &t)) {
-    if (!(grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t)) > 0.0f)) {
+    const float rho = grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t));
+    if (!(rho > 0.0f)) {
+      if (rho != rho) *status |= STATUS_NAN; /* a NaN density must not pass as empty space */
       lo = t;
       continue;
     }
@@ -95,11 +104,14 @@ static inline int lobe_first_hit(NV_CONSTANT const medium_params* m, GRID_PARAM,
 
 /* Transmittance along the straight segment a → b (1 when they coincide). */
 static inline vec3 lobe_transmittance_between(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 a, vec3 b,
-                                              int steps) {
+                                              int steps, NV_PRIVATE uint* status) {
   const vec3 ab = vec3_sub(b, a);
   const float dist = vec3_length(ab);
-  if (!(dist > 0.0f)) return vec3_splat(1.0f);
-  return march_transmittance(m, GRID_ARG, a, vec3_scale(ab, 1.0f / dist), dist, steps);
+  if (!(dist > 0.0f)) {
+    if (dist != dist) *status |= STATUS_NAN; /* a NaN point, not a coincident one */
+    return vec3_splat(1.0f);
+  }
+  return march_transmittance(m, GRID_ARG, a, vec3_scale(ab, 1.0f / dist), dist, steps, status);
 }
 
 /* Radiance of the view ray from `origin` along unit `dir`. `right` is the camera's unit right
@@ -107,7 +119,7 @@ static inline vec3 lobe_transmittance_between(NV_CONSTANT const medium_params* m
  * directions about +Z. */
 static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                  GRID_PARAM, NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
-                                 vec3 origin, vec3 dir, vec3 right) {
+                                 vec3 origin, vec3 dir, vec3 right, NV_PRIVATE uint* status) {
   /* L_b, and the view ray stops at the first rectangle it meets (rectangles are opaque). */
   const vec3 Lb = march_background(s, lights, origin, dir);
   if (!s->has_medium || p->lobe_points < 1) return Lb;
@@ -120,7 +132,7 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
 
   /* 1. First hit. */
   float t_x0;
-  if (!lobe_first_hit(m, GRID_ARG, &seg, p->steps, &t_x0)) return Lb;
+  if (!lobe_first_hit(m, GRID_ARG, &seg, p->steps, &t_x0, status)) return Lb;
   const vec3 x0 = vec3_madd(origin, dir, t_x0);
 
   /* 2. Lobe centre, depth clamped to the rest of the segment inside the box. */
@@ -144,7 +156,7 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
     const nv_float4 q = dirs[i];
     const vec3 d = vec3_add(vec3_add(vec3_scale(tx, q.x), vec3_scale(ty, q.y)), vec3_scale(dir, q.z));
     const vec3 P = vec3_madd(c, d, p->lobe_radius);
-    tr_sum = vec3_add(tr_sum, lobe_transmittance_between(m, GRID_ARG, x0, P, p->shadow_steps));
+    tr_sum = vec3_add(tr_sum, lobe_transmittance_between(m, GRID_ARG, x0, P, p->shadow_steps, status));
     const vec3 w_out = vec3_scale(d, -1.0f); /* from P_i towards c */
     for (int k = 0; k < s->num_lights; ++k) {
       vec3 to_light, I;
@@ -152,8 +164,11 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
       if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
       /* w_in: the light's propagation direction, light → P_i. */
       const float f = phase_eval(m->phase, m->g, vec3_scale(to_light, -1.0f), w_out);
-      if (!(f > 0.0f)) continue;
-      const vec3 tr = march_transmittance(m, GRID_ARG, P, to_light, dist, p->shadow_steps);
+      if (!(f > 0.0f)) {
+        if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
+        continue;
+      }
+      const vec3 tr = march_transmittance(m, GRID_ARG, P, to_light, dist, p->shadow_steps, status);
       in_sum = vec3_add(in_sum, vec3_scale(vec3_mul(tr, I), f / (dist * dist)));
     }
   }
@@ -170,7 +185,8 @@ static inline vec3 lobe_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT con
                               NV_PRIVATE uint* status) {
   NV_CONSTANT const camera_params* cam = &s->camera;
   const vec3 dir = lobe_view_dir(cam, (float)px + 0.5f, (float)py + 0.5f);
-  const vec3 L = lobe_radiance(s, lights, GRID_ARG, p, dirs, vec3_from4(cam->position), dir, vec3_from4(cam->right));
+  const vec3 L =
+      lobe_radiance(s, lights, GRID_ARG, p, dirs, vec3_from4(cam->position), dir, vec3_from4(cam->right), status);
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);

@@ -25,12 +25,13 @@
  * - parts of [t0, t1] outside the box belong to the nearest boundary cell (density is 0 there,
  *   so that stays conservative); callers clip to the box first (medium_intersect) to avoid waste.
  * - at most cells_x + cells_y + cells_z - 2 segments (each step advances one axis monotonically
- *   within its range); the loop is also capped at cells_x + cells_y + cells_z + 3 iterations, and
- *   next() returning 0 with it.t < it.t_end would mean that cap was hit (it cannot be by
- *   construction; a kernel may flag STATUS_ITERATION_CAP on it).
+ *   within its range); the loop is also capped at MAJORANT_DDA_BUDGET iterations over the whole
+ *   walk (derivation there). next() returning 0 with it.t < it.t_end means that cap was hit: it
+ *   sets STATUS_ITERATION_CAP in it.status (it cannot happen by construction; the flag proves it).
  * - a zero or negative-zero direction component never steps on that axis; a start point exactly
  *   on a cell boundary starts in the cell the ray enters (the lower one when d < 0). A
- *   non-finite o or d yields nothing.
+ *   non-finite o, d, t0 or t1 yields nothing and sets STATUS_NAN in it.status (a NaN upstream that
+ *   would otherwise read as an empty segment). Callers OR it.status into their status word.
  * Float rounding can place a point the DDA attributes to a cell up to a few ulps of its index
  * coordinates outside that cell; the host build pads every cell by MAJORANT_SLACK index units so
  * the bound holds there too. */
@@ -46,6 +47,18 @@
 /* Index units by which the host pads each cell when bounding it (see the note above). */
 #define MAJORANT_SLACK (1.0f / 256.0f)
 
+/* Loop iterations of majorant_iter_next over a whole walk. Derivation: an iteration either ends
+ * the walk (t_exit >= t_end: the last segment, then one more call that returns 0) or steps at least
+ * one axis, and an axis steps monotonically from its start cell to its last cell (exit = ∞ there), so
+ * at most (nx − 1) + (ny − 1) + (nz − 1) stepping iterations (zero-length segments included) + 2 =
+ * nx + ny + nz − 1 < the budget nx + ny + nz + 3. A 64³ majorant grid: ≤ 191 of 195.
+ * NARVAL_DDA_BUDGET replaces it by a constant at build time (tests force the cap with it). */
+#ifdef NARVAL_DDA_BUDGET
+#define MAJORANT_DDA_BUDGET(nx, ny, nz) (NARVAL_DDA_BUDGET)
+#else
+#define MAJORANT_DDA_BUDGET(nx, ny, nz) ((nx) + (ny) + (nz) + 3)
+#endif
+
 
 /* Private DDA state; fields are read by tests, kernels only call begin/next. */
 typedef struct majorant_iter {
@@ -57,8 +70,9 @@ typedef struct majorant_iter {
   int cx, cy, cz;          /* current cell */
   int step_x, step_y, step_z; /* +1, -1, or 0 (no movement along the axis) */
   int nx, ny, nz;          /* cell counts */
-  int budget;              /* loop iterations left (cells_x + cells_y + cells_z + 3) */
+  int budget;              /* loop iterations left (MAJORANT_DDA_BUDGET) */
   int seg_cell;            /* linear index of the cell of the last yielded segment */
+  uint status;             /* STATUS_NAN (non-finite input), STATUS_ITERATION_CAP (budget spent) */
 } majorant_iter;
 
 /* The cell of coordinate p along one axis, clamped to [0, n-1]: the c with c·size <= p <
@@ -123,12 +137,14 @@ static inline majorant_iter majorant_iter_begin(majorant_grid_params g, vec3 o, 
   it.step_x = d.x > 0.0f ? 1 : (d.x < 0.0f ? -1 : 0);
   it.step_y = d.y > 0.0f ? 1 : (d.y < 0.0f ? -1 : 0);
   it.step_z = d.z > 0.0f ? 1 : (d.z < 0.0f ? -1 : 0);
-  it.budget = g.cells_x + g.cells_y + g.cells_z + 3;
+  it.budget = MAJORANT_DDA_BUDGET(g.cells_x, g.cells_y, g.cells_z);
   it.seg_cell = -1;
-  if (!(nv_isfinite(t0) && nv_isfinite(t1) && vec3_is_finite(o) && vec3_is_finite(d)) || g.cells_x < 1 ||
-      g.cells_y < 1 || g.cells_z < 1) {
+  it.status = 0u;
+  const int finite = nv_isfinite(t0) && nv_isfinite(t1) && vec3_is_finite(o) && vec3_is_finite(d);
+  if (!finite || g.cells_x < 1 || g.cells_y < 1 || g.cells_z < 1) {
     it.budget = 0; /* nothing to walk */
     it.t_end = it.t;
+    if (!finite) it.status = STATUS_NAN;
   }
   it.cx = majorant_start_cell(o.x, d.x, it.inv_d.x, t0, it.size_x, it.nx);
   it.cy = majorant_start_cell(o.y, d.y, it.inv_d.y, t0, it.size_y, it.ny);
@@ -181,6 +197,7 @@ static inline int majorant_iter_next(NV_PRIVATE majorant_iter* it, NV_GLOBAL con
     /* Zero or negative length (rounding at the start point): the ray does not really pass
      * through this cell; go on to the next one. */
   }
+  if (it->t < it->t_end) it->status |= STATUS_ITERATION_CAP; /* budget spent before t_end */
   return 0;
 }
 

@@ -30,6 +30,8 @@ typedef struct march_iter {
   float delta;    /* step length, world units */
   int k, steps;
   int whole;      /* no majorant grid (host without bounds): the segment is one piece */
+  uint status;    /* the first walk's DDA status (majorant_iter.status); callers OR it into theirs.
+                     The second walk repeats the first and ends no later, so it adds nothing. */
 } march_iter;
 
 /* Next occupied piece of the walk into [*a, *b]; 0 when none is left. */
@@ -60,6 +62,7 @@ static inline march_iter march_begin(NV_CONSTANT const medium_params* m, GRID_PA
   march_iter probe = it;
   float a, b, len = 0.0f;
   while (march_next_piece(&probe, GRID_ARG, &a, &b)) len += b - a;
+  it.status = probe.dda.status;
   it.a = it.b = it.s_a = 0.0f;
   it.steps = steps > 0 ? steps : 1;
   it.delta = len / (float)it.steps;
@@ -85,22 +88,28 @@ static inline int march_next(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRIVATE f
 
 /* Optical depth τ from `origin` over `dist` along unit `dir`: `steps` midpoint samples over the
  * occupied part of the segment inside the box, Σ σt·Δ. 0 outside the box. The ray marcher's
- * octaves need τ itself (exp(−bⁱτ)), which survives where exp(−τ) underflows. */
+ * octaves need τ itself (exp(−bⁱτ)), which survives where exp(−τ) underflows. The walk's status
+ * bits (march_iter.status) go to *status; a NaN density stays in τ for the caller's pixel check. */
 static inline vec3 march_optical_depth(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
-                                       float dist, int steps) {
+                                       float dist, int steps, NV_PRIVATE uint* status) {
   medium_segment seg;
-  if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) return vec3_splat(0.0f);
+  if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) {
+    /* A NaN ray misses every box: say so rather than pass it off as clear air. */
+    if (!(vec3_is_finite(origin) && vec3_is_finite(dir) && dist == dist)) *status |= STATUS_NAN;
+    return vec3_splat(0.0f);
+  }
   march_iter it = march_begin(m, GRID_ARG, &seg, steps);
   vec3 tau = vec3_splat(0.0f);
   float t;
   while (march_next(&it, GRID_ARG, &t)) tau = vec3_add(tau, march_sigma_t(m, GRID_ARG, &seg, t));
+  *status |= it.status;
   return vec3_scale(tau, it.delta);
 }
 
 /* Transmittance exp(−τ) over the same quadrature (1 outside the box). */
 static inline vec3 march_transmittance(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
-                                       float dist, int steps) {
-  return vec3_exp_neg(march_optical_depth(m, GRID_ARG, origin, dir, dist, steps));
+                                       float dist, int steps, NV_PRIVATE uint* status) {
+  return vec3_exp_neg(march_optical_depth(m, GRID_ARG, origin, dir, dist, steps, status));
 }
 
 /* A light as seen from x, as a point: unit direction to it, distance, and the intensity I (W/sr)

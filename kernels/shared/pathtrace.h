@@ -2,7 +2,11 @@
  * Free flight by delta/spectral tracking, next-event estimation at every real scattering event
  * (ratio-tracked shadow rays, rectangle lights MIS-combined with phase sampling by the power
  * heuristic, point lights by NEE alone), `max_bounces` real scattering events, escaped rays add the
- * emitter they hit or the background. Rectangles are opaque: their back side is black. */
+ * emitter they hit or the background. Rectangles are opaque: their back side is black.
+ * Status word: STATUS_NAN for a non-finite sample (written as 0) or a NaN met on the way (density,
+ * majorant, phase value: tracking.h and below); STATUS_NEGATIVE_PDF for a phase-sampled direction
+ * whose pdf is not positive and for a majorant below σt (tracking.h); STATUS_ITERATION_CAP from the
+ * tracking walks' cap (tracking.h). Majorant (grid or global) and counters (-DCOUNTERS): tracking.h. */
 #ifndef NARVAL_PATHTRACE_H
 #define NARVAL_PATHTRACE_H
 
@@ -16,7 +20,7 @@
  * rectangle is in the way, else ratio tracking through the medium. */
 static inline vec3 pathtrace_shadow(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                     GRID_PARAM, int light_index, vec3 x, vec3 dir, float dist,
-                                    NV_PRIVATE rng_state* rng, NV_PRIVATE uint* status) {
+                                    NV_PRIVATE rng_state* rng, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
   float t_block;
   int front;
   if (intersect_lights(lights, s->num_lights, x, dir, 0.0f, light_index, &t_block, &front) >= 0 &&
@@ -24,21 +28,24 @@ static inline vec3 pathtrace_shadow(NV_CONSTANT const scene_params* s, NV_CONSTA
     return vec3_splat(0.0f);
   medium_segment seg;
   if (!s->has_medium || !medium_intersect(&s->medium, x, dir, 0.0f, dist, &seg)) return vec3_splat(1.0f);
-  return tracking_ratio(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, rng, status);
+  return tracking_ratio(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, rng, status TRACK_COUNTERS_ARG);
 }
 
 /* Direct light at a scattering point x for a path arriving along w_in, summed over all lights. */
 static inline vec3 pathtrace_direct(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                     GRID_PARAM, vec3 x, vec3 w_in, NV_PRIVATE rng_state* rng,
-                                    NV_PRIVATE uint* status) {
+                                    NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
   vec3 sum = vec3_splat(0.0f);
   for (int i = 0; i < s->num_lights; ++i) {
     const float u1 = rng_uniform(rng), u2 = rng_uniform(rng);
     light_sample ls;
     if (!light_sample_point(&lights[i], x, u1, u2, &ls)) continue;
     const float f = phase_eval(s->medium.phase, s->medium.g, w_in, ls.dir);
-    if (!(f > 0.0f)) continue;
-    const vec3 tr = pathtrace_shadow(s, lights, GRID_ARG, i, x, ls.dir, ls.dist, rng, status);
+    if (!(f > 0.0f)) {
+      if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
+      continue;
+    }
+    const vec3 tr = pathtrace_shadow(s, lights, GRID_ARG, i, x, ls.dir, ls.dist, rng, status TRACK_COUNTERS_ARG);
     if (vec3_is_zero(tr)) continue;
     /* Point light: Le·f·Tr·I/d². Rectangle: Le·f·Tr/pdf_light weighted against phase sampling,
      * whose pdf is f (sampling is exact). */
@@ -49,7 +56,7 @@ static inline vec3 pathtrace_direct(NV_CONSTANT const scene_params* s, NV_CONSTA
 }
 
 static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                    GRID_PARAM, int px, int py, uint sample, NV_PRIVATE uint* status) {
+                                    GRID_PARAM, int px, int py, uint sample, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
   const uint pixel = (uint)py * (uint)s->camera.width + (uint)px;
   rng_state rng = rng_init(s->seed, pixel, sample);
   const float jx = rng_uniform(&rng), jy = rng_uniform(&rng);
@@ -59,6 +66,10 @@ static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTA
   vec3 L = vec3_splat(0.0f), beta = vec3_splat(1.0f);
   float prev_phase_pdf = 0.0f; /* 0: the ray left the camera, no MIS on what it hits */
   int depth = 0;
+  /* Bounded without a cap of its own: every iteration either ends the path (break) or is a real
+   * scattering event that takes depth one closer to max_bounces (checked before the increment, so
+   * bounces = INT_MAX cannot overflow it): at most max_bounces + 1 iterations, each of whose walks
+   * is capped (tracking.h). Reaching max_bounces is the requested truncation, not a status. */
   for (;;) {
     float t_surf;
     int front = 0;
@@ -66,17 +77,19 @@ static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTA
     medium_segment seg;
     if (s->has_medium && medium_intersect(&s->medium, o, d, 0.0f, t_surf, &seg)) {
       float t_hit;
-      const int event = tracking_delta(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit, status);
+      const int event = tracking_delta(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit, status TRACK_COUNTERS_ARG);
       if (event == TRACK_ABSORBED) break;
       if (event == TRACK_SCATTERED) {
-        if (++depth > s->max_bounces) break;
+        if (depth >= s->max_bounces) break;
+        ++depth;
         const vec3 x = vec3_madd(o, d, t_hit);
-        L = vec3_add(L, vec3_mul(beta, pathtrace_direct(s, lights, GRID_ARG, x, d, &rng, status)));
+        L = vec3_add(L, vec3_mul(beta, pathtrace_direct(s, lights, GRID_ARG, x, d, &rng, status TRACK_COUNTERS_ARG)));
         const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
         float pdf;
         d = phase_sample(s->medium.phase, s->medium.g, d, u1, u2, &pdf);
-        if (!(pdf > 0.0f)) {
+        if (!(pdf > 0.0f)) { /* sampled a direction it gives no density (or NaN): unusable */
           *status |= STATUS_NEGATIVE_PDF;
+          if (pdf != pdf) *status |= STATUS_NAN;
           break;
         }
         o = x;

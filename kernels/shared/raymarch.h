@@ -40,7 +40,11 @@
  *
  * Empty space: the `steps` samples are spread over the occupied majorant cells only (march_iter in
  * march.h), so empty parts of the box cost nothing and the step is shorter where there is medium.
- * Samples of zero density change nothing (S = 0, e^{−0} = 1) and skip the light loop. */
+ * Samples of zero density change nothing (S = 0, e^{−0} = 1) and skip the light loop.
+ *
+ * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density or ray met on the
+ * way; STATUS_ITERATION_CAP when a DDA walk spends its budget (majorant.h). Nothing is sampled, so
+ * there is no pdf and never STATUS_NEGATIVE_PDF. */
 #ifndef NARVAL_RAYMARCH_H
 #define NARVAL_RAYMARCH_H
 
@@ -65,14 +69,15 @@ static inline float raymarch_step_weight(float x, float e) {
 /* Light arriving at x and scattered towards the camera, per unit σs: Σ_lights (I/d²) ⊙
  * Σ_{i<N} aⁱ p(g cⁱ, μ) exp(−bⁱ τ). view_dir points away from the camera. */
 static inline vec3 raymarch_light_sum(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                      GRID_PARAM, NV_CONSTANT const realtime_params* rp, vec3 x, vec3 view_dir) {
+                                      GRID_PARAM, NV_CONSTANT const realtime_params* rp, vec3 x, vec3 view_dir,
+                                      NV_PRIVATE uint* status) {
   NV_CONSTANT const medium_params* m = &s->medium;
   vec3 sum = vec3_splat(0.0f);
   for (int l = 0; l < s->num_lights; ++l) {
     vec3 dir, I;
     float dist;
     if (!march_light_as_point(&lights[l], x, &dir, &dist, &I)) continue;
-    const vec3 tau = march_optical_depth(m, GRID_ARG, x, dir, dist, rp->shadow_steps);
+    const vec3 tau = march_optical_depth(m, GRID_ARG, x, dir, dist, rp->shadow_steps, status);
     /* Octave 0: plain single scattering. */
     vec3 oct = vec3_scale(vec3_exp_neg(tau), phase_eval(m->phase, m->g, view_dir, dir));
     if (rp->octaves > 1) {
@@ -97,11 +102,13 @@ typedef struct raymarch_accum {
 
 /* Marches the view ray origin + t·dir over its box segment `seg` in `steps` steps of equal true
  * length spread over the occupied cells (march_iter: empty cells are skipped), sampled at their
- * midpoints. */
+ * midpoints. Loops: `steps` samples (march_next, its piece walk capped by the DDA budget), each
+ * with num_lights shadow marches of shadow_steps samples and `octaves` (≤ 16) terms: all bounded by
+ * the scene's own parameters, no cap of their own. */
 static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                     GRID_PARAM, NV_CONSTANT const realtime_params* rp,
                                     NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, int steps,
-                                    NV_PRIVATE raymarch_accum* acc) {
+                                    NV_PRIVATE raymarch_accum* acc, NV_PRIVATE uint* status) {
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
   march_iter it = march_begin(m, GRID_ARG, seg, steps);
@@ -109,12 +116,15 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
   float t;
   while (march_next(&it, GRID_ARG, &t)) {
     const float rho = grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t));
-    if (!(rho > 0.0f)) continue; /* S = 0 and e^{−0} = 1: the step would change nothing */
+    if (!(rho > 0.0f)) { /* S = 0 and e^{−0} = 1: the step would change nothing */
+      if (rho != rho) *status |= STATUS_NAN; /* a NaN density must not pass as empty space */
+      continue;
+    }
     const vec3 sigma_t = vec3_scale(vec3_add(sa, ss), rho); /* as march_sigma_t */
     const vec3 sigma_s = vec3_scale(ss, rho);
     vec3 S = vec3_splat(0.0f);
     if (!vec3_is_zero(sigma_s))
-      S = vec3_mul(sigma_s, raymarch_light_sum(s, lights, GRID_ARG, rp, vec3_madd(origin, dir, t), dir));
+      S = vec3_mul(sigma_s, raymarch_light_sum(s, lights, GRID_ARG, rp, vec3_madd(origin, dir, t), dir, status));
     const vec3 x = vec3_scale(sigma_t, dt);
     const vec3 e = vec3_exp_neg(x);
     const vec3 w = vec3_make(raymarch_step_weight(x.x, e.x), raymarch_step_weight(x.y, e.y),
@@ -122,6 +132,7 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
     acc->L = vec3_add(acc->L, vec3_mul(acc->T, vec3_scale(vec3_mul(S, w), dt)));
     acc->T = vec3_mul(acc->T, e);
   }
+  *status |= it.status;
 }
 
 /* Radiance through the centre of pixel (px, py). Pinhole: the ray leaves the lens centre. */
@@ -141,7 +152,7 @@ static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT
       raymarch_accum acc;
       acc.L = vec3_splat(0.0f);
       acc.T = vec3_splat(1.0f);
-      raymarch_segment(s, lights, GRID_ARG, rp, &seg, r.origin, r.dir, rp->steps, &acc);
+      raymarch_segment(s, lights, GRID_ARG, rp, &seg, r.origin, r.dir, rp->steps, &acc, status);
       L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
     }
   }

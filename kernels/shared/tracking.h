@@ -1,5 +1,5 @@
 /* tracking.h: null-collision free-flight and transmittance estimators (dissertation §4.2) against
- * a global majorant σ̄ >= max σt over the box and channels.
+ * a majorant σ̄ >= σt: per cell of the majorant grid (default) or one global σ̄ over the box.
  *
  * Free flight: delta tracking (Algorithm 1). For a grey medium (σt equal in all channels) it is
  * the analogue walk: at a tentative collision, absorb with P = σa/σ̄, scatter with P = σs/σ̄, else
@@ -13,37 +13,198 @@
 #define NARVAL_TRACKING_H
 
 #include "shared/grid.h"
+#include "shared/majorant.h"
 #include "shared/rng.h"
 #include "shared/sampling.h"
 #include "shared/structs.h"
 
-/* A guard against endless walks (σ̄·length of ~10⁷ mean free paths); flagged in the status word. */
-#define TRACKING_MAX_STEPS 10000000
+/* Iteration cap of both walks below; hitting it sets STATUS_ITERATION_CAP and ends the walk
+ * (delta: absorbed, ratio: transmittance 0). Derivation: the tentative collisions of a walk over a
+ * segment of length ℓ are a Poisson process of rate σ̄, so a walk takes 1 + Poisson(σ̄ℓ) steps. The
+ * densest scene among the tests and benchmarks (σt = 1e6 over a unit box, hard_cases_numeric) has
+ * σ̄ℓ ≈ 1e6 at the very most (its walks end at the first real collision), the dissertation's clouds
+ * σ̄ℓ < 1e4; P(Poisson(1e6) > 1e7) is 0 in any precision. The cap trips only for σ̄ℓ ≳ 1e7, which is
+ * also where float arithmetic gives out: the mean step 1/σ̄ ≈ 1e-7·ℓ is then about an ulp of t
+ * wherever t is of the order of ℓ or more (2⁻²³·t ≈ 1.2e-7·t), so t no longer follows the
+ * exponential steps it samples and, a little denser, t + step rounds back to t: the walk stands
+ * still. Hitting the cap costs one work-item 1.4 s on this machine's PoCL CPU (printed by
+ * StatusWord.OverDenseGridHitsTheTrackingCapWithoutHelp).
+ * NARVAL_TRACKING_MAX_STEPS overrides it at build time (tests force the cap with a small value). */
+#ifndef NARVAL_TRACKING_MAX_STEPS
+#define NARVAL_TRACKING_MAX_STEPS 10000000
+#endif
+#define TRACKING_MAX_STEPS NARVAL_TRACKING_MAX_STEPS
 
 #define TRACK_ESCAPED 0
 #define TRACK_SCATTERED 1
 #define TRACK_ABSORBED 2
+
+/* Status bits of the walks (structs.h), besides the cap:
+ * - STATUS_NAN: a non-finite majorant (NaN, or +inf: σ·D overflowing float; steps of 1/inf = 0
+ *   would never advance), a NaN density or NaN throughput. The walk ends (delta: absorbed, ratio:
+ *   transmittance 0) instead of treating the NaN as a null collision, which would drop it silently.
+ * - STATUS_NEGATIVE_PDF: σt(x) > σ̄ somewhere on the walk, i.e. the null-collision probability
+ *   σn/σ̄ = 1 − σt(x)/σ̄ (delta) or the ratio-tracking weight (ratio) is negative: the majorant does
+ *   not bound the medium and the estimate is biased. The global σ̄ = max σt · max ρ · (1 + 1e-5)
+ *   (scene_upload.cpp) rules this out for any grid whose maxValue is its true maximum (loaders
+ *   compute it); the grid's cells are built from the voxels themselves (majorant_grid.cpp proves the
+ *   bound), so maxValue does not enter. The walk goes on, as before.
+ * Both walks check medium_params.majorant (finite, positive) in either mode: the grid's σ̄ per cell
+ * is at most that (a cell value is at most the largest voxel), so it is finite too, and a medium
+ * whose global σ̄ is 0 has only empty cells. The cap counts tentative collisions: with the grid
+ * they are Poisson(∫σ̄_grid) <= Poisson(σ̄ℓ), so the derivation above holds; the DDA under the walk
+ * has its own budget (majorant.h). */
+
+/* ---- Majorants: the grid (pbrt-v4's DDAMajorantIterator) or one global σ̄ ------------------------
+ *
+ * Grid (default): the walk follows the majorant grid's cells along the ray (majorant.h DDA); over a
+ * cell σ̄ = max-channel σt · cell value · MAJORANT_MARGIN (majorant.h, the cell value bounds the
+ * trilinear density there). Global: one segment [t, t_max] with σ̄ = medium_params.majorant.
+ * Chosen at build time, so neither kernel carries the other's branch:
+ * - device: -DMAJORANT_GLOBAL selects the global majorant; MEDIUM_HOMOGENEOUS also takes it (its one
+ *   cell would give the same σ̄, without a DDA);
+ * - host: -DMAJORANT_GLOBAL likewise, else the grid when the grid_view carries majorant cells and
+ *   the medium has cells (a runtime test: host tests walk both ways in one binary).
+ *
+ * Free-flight sampling across segments (the budget). A tentative collision is where the majorant's
+ * optical depth from the previous one reaches τ = −ln(1 − u), u uniform (Exp(1)). The walk spends τ
+ * segment by segment: in a segment [s0, s1] with σ̄_i > 0 at position t, if t + τ/σ̄_i < s1 the
+ * collision is there; else τ −= σ̄_i·(s1 − t) and the walk moves on to s1 with what is left. A cell
+ * with σ̄_i = 0 spends nothing and is crossed without a density lookup or a random number. This is
+ * exactly a sample of the inhomogeneous Poisson process of rate σ̄(t) (the inverse of its
+ * cumulative rate), so pbrt-v4's alternative, a fresh u at every boundary (memorylessness), has the
+ * same distribution; carrying τ uses one uniform per collision, as the global walk does. With one
+ * segment the arithmetic is the global walk's, bit for bit (t + (−ln(1−u))/σ̄, the same compare).
+ * Rounding: t + τ/σ̄_i >= s1 while σ̄_i·(s1 − t) > τ by an ulp leaves τ < 0, clamped to 0 (a
+ * collision at the next segment's start: an ulp-sized shift of a measure-zero event). */
+#if defined(MAJORANT_GLOBAL) || (defined(NV_DEVICE) && defined(MEDIUM_HOMOGENEOUS))
+#define TRACKING_USE_MAJORANT_GRID(m) 0
+#elif defined(NV_DEVICE)
+#define TRACKING_USE_MAJORANT_GRID(m) 1
+#else
+#define TRACKING_USE_MAJORANT_GRID(m)                                                                   \
+  (GRID_MAJORANTS != 0 && (m)->majorant_grid.cells_x > 0 && (m)->majorant_grid.cells_y > 0 &&           \
+   (m)->majorant_grid.cells_z > 0)
+#endif
+
+/* Counters (-DCOUNTERS): per work-item counts of tentative (delta/spectral tracking) and real
+ * (absorbing or scattering) collisions and of density lookups (both walks), in private 64-bit
+ * integers; the kernel adds them to per-pixel slots of its own (pathtrace.cl), the host sums those:
+ * no atomics, no floats, no overflow (2^64). Without COUNTERS the parameter and every count vanish
+ * from the source. Every delta-tracking tentative collision reads the density once, so
+ * lookups − tentative = the ratio-tracking lookups of the shadow rays. */
+typedef struct track_counters {
+  nv_ulong tentative;
+  nv_ulong real;
+  nv_ulong lookups;
+} track_counters;
+#ifdef COUNTERS
+#define TRACK_COUNTERS_PARAM , NV_PRIVATE track_counters* counters
+#define TRACK_COUNTERS_ARG , counters
+#define TRACK_COUNT(field) (counters->field += 1u)
+#else
+#define TRACK_COUNTERS_PARAM
+#define TRACK_COUNTERS_ARG
+#define TRACK_COUNT(field) ((void)0)
+#endif
+
+/* The walk's position in its majorant segments. */
+typedef struct tracking_walk {
+  majorant_iter dda;  /* grid: the cells still ahead */
+  float t;            /* the last tentative collision, or the start of the current segment */
+  float seg_end;      /* end of the current segment */
+  float bar;          /* σ̄ over the current segment (0: empty cell, or none yet) */
+  float bar_scale;    /* grid: σ̄ per unit of cell value, max-channel σt · MAJORANT_MARGIN */
+  int grid;           /* 1: segments from the DDA; 0: the one global segment */
+} tracking_walk;
+
+/* A walk over [t0, t1] of the index-space ray o + t·d. Callers have checked m->majorant is finite
+ * and positive (so are σt and, with the grid, bar_scale). */
+static inline tracking_walk tracking_walk_begin(NV_CONSTANT const medium_params* m, int use_grid, vec3 o, vec3 d,
+                                                float t0, float t1) {
+  tracking_walk w;
+  w.t = t0;
+  w.grid = use_grid;
+  if (use_grid) {
+    const vec3 st = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+    w.bar_scale = nv_fmax(st.x, nv_fmax(st.y, st.z)) * MAJORANT_MARGIN;
+    w.dda = majorant_iter_begin(m->majorant_grid, o, d, t0, t1);
+    w.seg_end = t0; /* no segment yet: the first step fetches one */
+    w.bar = 0.0f;
+  } else {
+    w.bar_scale = 0.0f;
+    w.dda.status = 0u;
+    w.seg_end = t1;
+    w.bar = m->majorant;
+  }
+  return w;
+}
+
+/* Spends the majorant optical depth `tau` from w->t on (see "the budget" above). 1: w->t is the
+ * next tentative collision, w->bar its σ̄. 0: the walk left [t0, t1] first; the DDA's status bits
+ * (non-finite ray, spent budget) go to *status. */
+static inline int tracking_walk_step(NV_PRIVATE tracking_walk* w, NV_GLOBAL const float* cells, float tau,
+                                     NV_PRIVATE uint* status) {
+  for (;;) {
+    if (w->bar > 0.0f) {
+      const float dt = tau / w->bar;
+      if (w->t + dt < w->seg_end) {
+        w->t += dt;
+        return 1;
+      }
+      tau = nv_fmax(0.0f, tau - w->bar * (w->seg_end - w->t));
+    }
+    if (!w->grid) return 0;
+    float s0, s1, cell;
+    if (!majorant_iter_next(&w->dda, cells, &s0, &s1, &cell)) {
+      *status |= w->dda.status;
+      return 0;
+    }
+    w->t = s0;
+    w->seg_end = s1;
+    w->bar = w->bar_scale * cell;
+  }
+}
 
 /* Walks o + t·d (index-space origin and direction; t is the world-space ray parameter because d is
  * the world direction mapped by the same affine map) from t to t_max. On TRACK_SCATTERED, *t_out
  * is the collision and *beta has been reweighted (chromatic media only). */
 static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 o, vec3 d, float t,
                                  float t_max, NV_PRIVATE rng_state* rng, NV_PRIVATE vec3* beta,
-                                 NV_PRIVATE float* t_out, NV_PRIVATE uint* status) {
-  const float sigma_bar = m->majorant;
-  if (!(sigma_bar > 0.0f)) return TRACK_ESCAPED;
+                                 NV_PRIVATE float* t_out, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+  if (!(m->majorant < NV_INFINITY)) { /* NaN or +inf */
+    *status |= STATUS_NAN;
+    return TRACK_ABSORBED;
+  }
+  if (!(m->majorant > 0.0f)) return TRACK_ESCAPED;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
   const int grey = m->grey;
+  tracking_walk w = tracking_walk_begin(m, TRACKING_USE_MAJORANT_GRID(m), o, d, t, t_max);
   for (int step = 0; step < TRACKING_MAX_STEPS; ++step) {
-    t += sample_exponential(rng_uniform(rng), sigma_bar);
-    if (t >= t_max) return TRACK_ESCAPED;
-    const float rho = grid_density(GRID_ARG, vec3_madd(o, d, t));
+    if (!tracking_walk_step(&w, GRID_MAJORANTS, sample_exponential(rng_uniform(rng), 1.0f), status))
+      return TRACK_ESCAPED;
+    const float sigma_bar = w.bar;
+    TRACK_COUNT(tentative);
+    TRACK_COUNT(lookups);
+    const float rho = grid_density(GRID_ARG, vec3_madd(o, d, w.t));
     const float u = rng_uniform(rng);
     if (grey) {
       const float pa = sa.x * rho / sigma_bar, ps = ss.x * rho / sigma_bar;
-      if (u < pa) return TRACK_ABSORBED;
+      const float pn = 1.0f - pa - ps; /* null-collision probability */
+      if (!(pn >= 0.0f)) {
+        if (!(pn < 0.0f)) { /* NaN: a NaN density would otherwise pass as a null collision */
+          *status |= STATUS_NAN;
+          return TRACK_ABSORBED;
+        }
+        *status |= STATUS_NEGATIVE_PDF;
+      }
+      if (u < pa) {
+        TRACK_COUNT(real);
+        return TRACK_ABSORBED;
+      }
       if (u < pa + ps) {
-        *t_out = t;
+        TRACK_COUNT(real);
+        *t_out = w.t;
         return TRACK_SCATTERED;
       }
       continue;
@@ -51,16 +212,24 @@ static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM,
     const vec3 b = *beta;
     const vec3 sig_a = vec3_scale(sa, rho), sig_s = vec3_scale(ss, rho);
     const vec3 sig_n = vec3_sub(vec3_splat(sigma_bar), vec3_add(sig_a, sig_s));
+    if (nv_fmin(sig_n.x, nv_fmin(sig_n.y, sig_n.z)) < 0.0f) *status |= STATUS_NEGATIVE_PDF;
     const float wa = vec3_average(vec3_mul(sig_a, b));
     const float ws = vec3_average(vec3_mul(sig_s, b));
     const float wn = vec3_average(vec3_mul(sig_n, b));
     const float c = wa + ws + wn;
-    if (!(c > 0.0f)) return TRACK_ABSORBED; /* zero throughput: nothing left to carry */
+    if (!(c > 0.0f)) {
+      if (c != c) *status |= STATUS_NAN; /* NaN density or throughput */
+      return TRACK_ABSORBED;             /* else zero throughput: nothing left to carry */
+    }
     const float x = u * c;
-    if (x < wa) return TRACK_ABSORBED;
+    if (x < wa) {
+      TRACK_COUNT(real);
+      return TRACK_ABSORBED;
+    }
     if (x < wa + ws) {
+      TRACK_COUNT(real);
       *beta = vec3_scale(vec3_mul(b, sig_s), c / (sigma_bar * ws));
-      *t_out = t;
+      *t_out = w.t;
       return TRACK_SCATTERED;
     }
     *beta = vec3_scale(vec3_mul(b, sig_n), c / (sigma_bar * wn));
@@ -71,19 +240,32 @@ static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM,
 
 /* Ratio-tracking estimate of the transmittance along o + t·d over [t, t_max]. */
 static inline vec3 tracking_ratio(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 o, vec3 d, float t,
-                                  float t_max, NV_PRIVATE rng_state* rng, NV_PRIVATE uint* status) {
+                                  float t_max, NV_PRIVATE rng_state* rng, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
   vec3 tr = vec3_splat(1.0f);
-  const float sigma_bar = m->majorant;
-  if (!(sigma_bar > 0.0f)) return tr;
+  if (!(m->majorant < NV_INFINITY)) { /* NaN or +inf, see tracking_delta */
+    *status |= STATUS_NAN;
+    return vec3_splat(0.0f);
+  }
+  if (!(m->majorant > 0.0f)) return tr;
   const vec3 st = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
   /* A homogeneous medium has the closed form: Beer-Lambert, no variance. */
   if (GRID_IS_HOMOGENEOUS(GRID_ARG)) return vec3_exp_neg(vec3_scale(st, nv_fmax(0.0f, t_max - t)));
-  const float inv_bar = 1.0f / sigma_bar;
+  tracking_walk w = tracking_walk_begin(m, TRACKING_USE_MAJORANT_GRID(m), o, d, t, t_max);
   for (int step = 0; step < TRACKING_MAX_STEPS; ++step) {
-    t += sample_exponential(rng_uniform(rng), sigma_bar);
-    if (t >= t_max) return tr;
-    const float rho = grid_density(GRID_ARG, vec3_madd(o, d, t));
-    tr = vec3_mul(tr, vec3_sub(vec3_splat(1.0f), vec3_scale(st, rho * inv_bar)));
+    if (!tracking_walk_step(&w, GRID_MAJORANTS, sample_exponential(rng_uniform(rng), 1.0f), status)) return tr;
+    const float inv_bar = 1.0f / w.bar;
+    TRACK_COUNT(lookups);
+    const float rho = grid_density(GRID_ARG, vec3_madd(o, d, w.t));
+    const vec3 wt = vec3_sub(vec3_splat(1.0f), vec3_scale(st, rho * inv_bar)); /* σn/σ̄ per channel */
+    const float w_min = nv_fmin(wt.x, nv_fmin(wt.y, wt.z));
+    if (!(w_min >= 0.0f)) {
+      if (w_min != w_min) { /* NaN density: NaN in all three channels */
+        *status |= STATUS_NAN;
+        return vec3_splat(0.0f);
+      }
+      *status |= STATUS_NEGATIVE_PDF;
+    }
+    tr = vec3_mul(tr, wt);
     if (vec3_is_zero(tr)) return tr;
   }
   *status |= STATUS_ITERATION_CAP;

@@ -282,6 +282,21 @@ TEST(ProgramCache, BuildErrorNamesTheRealFileAndLine) {
   }
 }
 
+// NVIDIA's compiler ignores #line and reports the flattened line ("<kernel>:76:25:"). In this
+// flattened source, line 5 is the first line after the marker "#line 3 \"b.h\"" (line 4), so
+// flattened line 6 is b.h:4; line 2 follows "#line 1 \"a.cl\"" (line 1), so it is a.cl:1; text
+// before any marker and other numbers stay as they are.
+TEST(ProgramCache, BuildLogLinesOfDriversThatIgnoreLineMarkersAreMapped) {
+  const std::string source = "#line 1 \"a.cl\"\nint a;\nint b;\n#line 3 \"kernels/shared/b.h\"\nint c;\nint d;\n";
+  EXPECT_EQ(mapBuildLogLines("<kernel>:6:25: error: x\n<kernel>:2:1: note: y\n<source>:5:3: warning\n", source),
+            "kernels/shared/b.h:4:25: error: x\na.cl:1:1: note: y\nkernels/shared/b.h:3:3: warning\n");
+  EXPECT_EQ(mapBuildLogLines("a.cl:2:1: error (already mapped by the driver) 10:3:", source),
+            "a.cl:2:1: error (already mapped by the driver) 10:3:");
+  EXPECT_EQ(mapBuildLogLines("<kernel>:1:1: before any marker", "int x;\n#line 1 \"a.cl\"\nint y;\n"),
+            "<kernel>:1:1: before any marker");
+  EXPECT_EQ(mapBuildLogLines("<kernel>:3:1: no markers", "int x;\n"), "<kernel>:3:1: no markers");
+}
+
 TEST(ProgramCache, UnknownKernelFileIsARuntimeError) {
   SKIP_WITHOUT_DEVICES();
   ClRuntime rt("");

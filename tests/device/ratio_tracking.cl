@@ -28,3 +28,26 @@ __kernel void ratio_tracking_stats(__constant medium_params* m, GRID_KERNEL_PARA
   out_var[i] = n > 1u ? m2 / (float)(n - 1u) : 0.0f;
   if (status) atomic_or(status_word, status);
 }
+
+/* Delta tracking on the same rays: the fraction of n walks (absorption-only view: any real
+ * collision ends the walk) that escape the box, the free-flight estimate of the transmittance. */
+__kernel void delta_escape_fraction(__constant medium_params* m, GRID_KERNEL_PARAM, __global const float4* rays,
+                                    uint n, __global float* out_fraction, __global uint* status_word) {
+  const int i = get_global_id(0);
+  const vec3 o = rays[2 * i].xyz;
+  const vec3 d = rays[2 * i + 1].xyz;
+  uint status = 0u;
+  medium_segment seg;
+  uint escaped = n;
+  if (medium_intersect(m, o, d, 0.0f, NV_INFINITY, &seg)) {
+    escaped = 0u;
+    for (uint s = 0u; s < n; ++s) {
+      rng_state rng = rng_init(4321u, (uint)i, s);
+      vec3 beta = vec3_splat(1.0f);
+      float t_hit;
+      escaped += tracking_delta(m, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit, &status) == TRACK_ESCAPED;
+    }
+  }
+  out_fraction[i] = (float)escaped / (float)n;
+  if (status) atomic_or(status_word, status);
+}

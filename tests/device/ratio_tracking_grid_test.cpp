@@ -3,10 +3,19 @@
 // reconstruction of the same grid along the same rays. Ratio tracking is unbiased, so the mean of n
 // estimates lies within 4 standard errors of exp(-τ) (two-sided, ~6e-5 false failures per ray),
 // plus a 2e-3 allowance for the quadrature and for the device sampler's own interpolation arithmetic.
+// Delta tracking (Algorithm 1) on the same rays: the fraction of n walks that escape the box is
+// binomial with p = exp(-τ) (the medium is grey, so the analogue walk), within 4·sqrt(p(1-p)/n)
+// (~6e-5 per ray) plus the same allowance.
+// Run in both grid storages (the 3D image and the float buffer, kernels/shared/grid.h) and with both
+// majorants (kernels/shared/tracking.h): the majorant grid walked by DDA (the default build, with the
+// scene's own majorant cells) and the global one (-DMAJORANT_GLOBAL). 16 rays × 4 builds at 6.3e-5
+// each: a false failure about once in 250 runs of the whole file — the seeds are fixed, so in
+// practice the outcome is the same on every run of one device.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
+#include <string>
 
 #include "cl/cl_runtime.h"
 #include "render/device_grid.h"
@@ -23,7 +32,7 @@ const std::map<std::string, std::string>& testKernelSources();
 namespace narval {
 namespace {
 
-TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepth) {
+void checkRatioTracking(GridStorage storage, bool globalMajorant) {
   const DenseGrid cloud = makeCloud(32, 5);
   const Scene scene = parseScene(R"({
     "materials": [{"name": "m", "type": "volume", "scattering": [2, 2, 2], "absorption": [0.5, 0.5, 0.5],
@@ -50,7 +59,9 @@ TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepth) {
   }
 
   ClRuntime rt("");
-  cl::Program program = buildProgram(rt, "ratio_tracking.cl", "", &testKernelSources());
+  std::string options = gridStorageBuildOption(storage);
+  if (globalMajorant) options += (options.empty() ? "" : " ") + std::string("-DMAJORANT_GLOBAL");
+  cl::Program program = buildProgram(rt, "ratio_tracking.cl", options, &testKernelSources());
   cl::Kernel k(program, "ratio_tracking_stats");
   const cl_uint n = 20000;
   cl::Buffer mBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(m), const_cast<medium_params*>(&m));
@@ -59,12 +70,22 @@ TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepth) {
   cl::Buffer varBuf(rt.context, CL_MEM_WRITE_ONLY, numRays * sizeof(float));
   cl_uint zero = 0;
   cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof(cl_uint), &zero);
-  cl::Image3D image = uploadGrid(rt, cloud);
-  // Ratio tracking against the global majorant reads no majorant cells: a one-cell stand-in.
-  cl::Buffer cellsBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(float),
-                      const_cast<float*>(&cloud.maxValue));
+  cl::Image3D image;
+  cl::Buffer buffer;
+  if (storage == GridStorage::Buffer)
+    buffer = uploadGridBuffer(rt, cloud);
+  else
+    image = uploadGridImage(rt, cloud);
+  // The scene's majorant cells (medium.majorant_grid says how many); the global build ignores them.
+  ASSERT_EQ(ds.majorants.size(), size_t(m.majorant_grid.cells_x) * m.majorant_grid.cells_y * m.majorant_grid.cells_z);
+  ASSERT_GT(ds.majorants.size(), 1u);
+  cl::Buffer cellsBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, ds.majorants.size() * sizeof(float),
+                      const_cast<float*>(ds.majorants.data()));
   k.setArg(0, mBuf);
-  k.setArg(1, image);
+  if (storage == GridStorage::Buffer)
+    k.setArg(1, buffer);
+  else
+    k.setArg(1, image);
   k.setArg(2, cellsBuf);
   k.setArg(3, rayBuf);
   k.setArg(4, n);
@@ -72,10 +93,25 @@ TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepth) {
   k.setArg(6, varBuf);
   k.setArg(7, statusBuf);
   rt.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(numRays), cl::NullRange);
-  std::vector<float> mean(numRays), var(numRays);
+  // Delta tracking's escape fraction on the same rays (the medium is grey: the analogue walk).
+  cl::Kernel kd(program, "delta_escape_fraction");
+  cl::Buffer fracBuf(rt.context, CL_MEM_WRITE_ONLY, numRays * sizeof(float));
+  kd.setArg(0, mBuf);
+  if (storage == GridStorage::Buffer)
+    kd.setArg(1, buffer);
+  else
+    kd.setArg(1, image);
+  kd.setArg(2, cellsBuf);
+  kd.setArg(3, rayBuf);
+  kd.setArg(4, n);
+  kd.setArg(5, fracBuf);
+  kd.setArg(6, statusBuf);
+  rt.queue.enqueueNDRangeKernel(kd, cl::NullRange, cl::NDRange(numRays), cl::NullRange);
+  std::vector<float> mean(numRays), var(numRays), escaped(numRays);
   cl_uint status = 0;
   rt.queue.enqueueReadBuffer(meanBuf, CL_TRUE, 0, numRays * sizeof(float), mean.data());
   rt.queue.enqueueReadBuffer(varBuf, CL_TRUE, 0, numRays * sizeof(float), var.data());
+  rt.queue.enqueueReadBuffer(fracBuf, CL_TRUE, 0, numRays * sizeof(float), escaped.data());
   rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &status);
   EXPECT_EQ(status, 0u);
 
@@ -96,8 +132,24 @@ TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepth) {
     crossing += tau > 0.5;
     EXPECT_NEAR(mean[size_t(i)], expected, 4 * std::sqrt(var[size_t(i)] / n) + 2e-3)
         << "ray " << i << ", optical depth " << tau;
+    // Binomial: n walks escape with probability exp(-τ) each.
+    EXPECT_NEAR(escaped[size_t(i)], expected, 4 * std::sqrt(expected * (1 - expected) / n) + 2e-3)
+        << "delta tracking, ray " << i << ", optical depth " << tau;
   }
   EXPECT_GE(crossing, numRays / 2) << "most rays should cross real density, or the test proves little";
+}
+
+TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepthImageStorage) {
+  checkRatioTracking(GridStorage::Image, false);
+}
+TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepthBufferStorage) {
+  checkRatioTracking(GridStorage::Buffer, false);
+}
+TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepthImageStorageGlobalMajorant) {
+  checkRatioTracking(GridStorage::Image, true);
+}
+TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepthBufferStorageGlobalMajorant) {
+  checkRatioTracking(GridStorage::Buffer, true);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "cl/cl_runtime.h"
 #include "render/pathtrace_renderer.h"
+#include "render/realtime_renderer.h"
 #include "shared/structs.h"
 #include "scene/scene.h"
 #include "unit/stat_util.h"
@@ -23,11 +24,19 @@ inline ClRuntime& runtime() {
 
 inline Scene sceneFromJson(const std::string& json) { return parseScene(json, "test_scene.json"); }
 
+// The path tracer. Every render helper takes the grid storage from the scene (renderer.storage;
+// auto: the buffer on PoCL), as the CLI does.
 inline RenderResult render(const Scene& scene, const DenseGrid* grid = nullptr, int lx = 8, int ly = 8) {
   RenderOptions o;
   o.localSizeX = lx;
   o.localSizeY = ly;
   return renderPathtrace(runtime(), scene, grid, o);
+}
+
+// The scene's own renderer.algorithm (one frame for the real-time ones).
+inline RenderResult renderAlgorithm(const Scene& scene, const DenseGrid* grid = nullptr) {
+  if (scene.renderer.algorithm == "pathtrace") return render(scene, grid);
+  return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
 }
 
 // A ray in double precision.

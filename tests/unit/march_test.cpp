@@ -78,7 +78,9 @@ TEST(MarchSkipsEmptySpace, EmptyRaysCostNoSamples) {
   march_iter it = march_begin(&m, &g, &seg, 50);
   float t;
   EXPECT_FALSE(march_next(&it, &g, &t));
-  EXPECT_EQ(march_optical_depth(&m, &g, vec3_make(-12, -10, 0), vec3_make(0, 1, 0), 100.0f, 50).x, 0.0f);
+  uint status = 0u;
+  EXPECT_EQ(march_optical_depth(&m, &g, vec3_make(-12, -10, 0), vec3_make(0, 1, 0), 100.0f, 50, &status).x, 0.0f);
+  EXPECT_EQ(status, 0u);
   march_iter plain = march_begin(&m, &whole, &seg, 50);
   int samples = 0;
   while (march_next(&plain, &whole, &t)) ++samples;

@@ -141,6 +141,7 @@ TEST_F(SceneFiles, Listing41LoadsAsPrinted) {
   EXPECT_EQ(s.renderer.exposure, 0.0f);
   EXPECT_EQ(s.renderer.algorithm, "pathtrace");
   EXPECT_EQ(s.renderer.seed, 0u);
+  EXPECT_EQ(s.renderer.storage, GridStorage::Auto);
   EXPECT_EQ(s.background, (Vec3f{0, 0, 0}));
 }
 
@@ -324,6 +325,8 @@ TEST(SceneErrors, BadValuesNameFileKeyAndProblem) {
       {"/materials/1/gridSpace", "world", "s.json: materials[1].gridSpace: unknown value \"world\" (allowed: unit, file)"},
       {"/primitives/1/type", "sphere", "s.json: primitives[1].type: unknown value \"sphere\" (allowed: rectangle, volume, point)"},
       {"/renderer/algorithm", "mlt", "s.json: renderer.algorithm: unknown value \"mlt\" (allowed: pathtrace, raymarch, lobe)"},
+      {"/renderer/storage", "texture", "s.json: renderer.storage: unknown value \"texture\" (allowed: auto, image, buffer)"},
+      {"/renderer/storage", true, "s.json: renderer.storage: expected a string, got boolean"},
       {"/renderer/toneMapping", "filmic", "s.json: renderer.toneMapping: unknown value \"filmic\" (allowed: none, reinhard, aces)"},
       // out of range
       {"/materials/1/g", 1.5, "s.json: materials[1].g: must be in [-1, 1], got 1.5"},
@@ -445,7 +448,7 @@ TEST(SceneOverrides, ReplaceCreateAndParseValues) {
                              {"renderer.spp=16", "materials.1.g=0.9", "background=[1,1,1]",
                               "renderer.seed=3", "renderer.lobe.lobePoints=10", "renderer.algorithm=lobe",
                               "materials[1].density=2.5", "renderer.toneMapping=false",
-                              "camera.position.2=-9", "renderer.spp=32"});
+                              "camera.position.2=-9", "renderer.spp=32", "renderer.storage=buffer"});
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(s.renderer.spp, 32);  // later overrides win
   EXPECT_EQ(s.materials[1].g, 0.9f);
@@ -456,6 +459,7 @@ TEST(SceneOverrides, ReplaceCreateAndParseValues) {
   EXPECT_EQ(s.materials[1].density, 2.5f);
   EXPECT_EQ(s.renderer.toneMapping, ToneMapping::None);
   EXPECT_EQ(s.camera.position, (Vec3f{0, 0, -9}));
+  EXPECT_EQ(s.renderer.storage, GridStorage::Buffer);
 }
 
 TEST(SceneOverrides, OverriddenValuesAreValidated) {

@@ -1,0 +1,9 @@
+/* Test kernel: grid_density at a batch of index-space points, in the grid storage the program is
+ * built for (-DGRID_STORAGE_BUFFER: the float buffer; otherwise the 3D image and its sampler). */
+#include "shared/grid.h"
+
+__kernel void grid_lookup(GRID_KERNEL_PARAM, __global const float4* points, __global float* out) {
+  const int i = get_global_id(0);
+  const float4 q = points[i];
+  out[i] = grid_density(GRID_ARG, vec3_make(q.x, q.y, q.z));
+}
