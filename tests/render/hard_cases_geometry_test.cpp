@@ -451,8 +451,11 @@ double voxelTransmittance(const DenseGrid& g, const nv_affine& m, const Ray& r) 
 
 TEST(HardCasesGeometry, OneVoxelGridRaymarchAndLobeMatchQuadrature) {
   const DenseGrid g = oneVoxel();
+  // Buffer storage: the shared float filter on every device. A GPU's image sampler quantises the
+  // trilinear weights to 8 bits (grid_storage_test.cpp bounds that), which moved these pixels by up
+  // to 0.3% on an H100, beyond the 1e-4 asked here.
   const Scene scene = sceneFromJson(voxelScene(
-      R"({"resolution": [5, 5], "raymarch": {"steps": 64, "shadowSteps": 10},
+      R"({"resolution": [5, 5], "storage": "buffer", "raymarch": {"steps": 64, "shadowSteps": 10},
           "lobe": {"depthFactor": 1000, "lobeRadius": 0}})", 0.05));
   const scene_params sp = buildDeviceScene(scene, &g).params;
   const double centre = voxelTransmittance(g, sp.medium.world_to_index, pixelRay(sp.camera, 2.5, 2.5));
