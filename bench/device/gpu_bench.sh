@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# bench/device/gpu_bench.sh [OUTDIR]: on the GPU machine (after `source bench/device/setup.sh`):
+# the three shipped scenes at 1200x600, path tracing 256 spp per grid storage and majorant, and
+# 20 frames of raymarch and lobe per storage; prints a Markdown table. Not a test.
+set -u
+cd "$(dirname "$0")/../.."
+N=$PWD/build/narval
+out=${1:-/tmp/narval-gpu-bench}
+mkdir -p "$out"
+for sc in cloud listing_4_1 disney_cloud; do
+  S=$PWD/scenes/$sc.json
+  "$N" render "$S" -o "$out/warm.exr" --resolution 64x32 --spp 4 >/dev/null 2>&1  # fills the program cache
+  for st in image buffer; do
+    for mj in grid global; do
+      "$N" render "$S" -o "$out/pt_${sc}_${st}_${mj}.exr" --resolution 1200x600 --spp 256 --storage $st \
+        --majorant $mj --stats-json "$out/pt_${sc}_${st}_${mj}.json" >/dev/null 2>&1 || echo "failed: pt $sc $st $mj" >&2
+    done
+    for alg in raymarch lobe; do
+      "$N" render "$S" -o "$out/${alg}_${sc}_${st}.exr" --algorithm $alg --resolution 1200x600 --frames 20 \
+        --storage $st --stats-json "$out/${alg}_${sc}_${st}.json" >/dev/null 2>&1 || echo "failed: $alg $sc $st" >&2
+    done
+  done
+done
+python3 - "$out" <<'PY'
+import glob, json, os, sys
+print("| run | storage | majorant | seconds | Msamples/s | median ms/frame |")
+print("|---|---|---|---|---|---|")
+for f in sorted(glob.glob(os.path.join(sys.argv[1], "*.json"))):
+    j = json.load(open(f))
+    ms = j.get("ms_per_frame", {}).get("median", "")
+    ms = f"{ms:.2f}" if ms != "" else ""
+    print(f"| {os.path.basename(f)[:-5]} | {j.get('storage')} | {j.get('majorant', '')} | {j['seconds']:.3f} "
+          f"| {j['samples_per_second'] / 1e6:.1f} | {ms} |")
+PY

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# bench/device/pack.sh: packs what a run on the lent GPU machine needs into .devrun/ (ignored via
+# .git/info/exclude; name it in the device tool's `carry`). That machine is not Debian and has no
+# narval dependencies: this carries the built binaries, their shared libraries (xz, ~7 MB), an ICD
+# file naming NVIDIA's libnvidia-opencl.so.1 and the small Disney cloud. There, in the repository
+# root: `source bench/device/setup.sh`, then run build/narval, the test binaries or
+# bench/device/gpu_bench.sh. See bench/RESULTS.md ("NVIDIA H100") for what worked.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+[ -x build/narval ] || scripts/setup.sh >/dev/null
+grep -qx '/.devrun/' .git/info/exclude 2>/dev/null || { mkdir -p .git/info; echo '/.devrun/' >>.git/info/exclude; }
+rm -rf .devrun && mkdir -p .devrun/bin .devrun/icd .devrun/data .devrun/lib
+cp build/narval build/tests/narval_render_tests build/tests/narval_device_tests build/tests/narval_cli_tests .devrun/bin/
+strip .devrun/bin/*
+# Every shared library the binaries use except the C/C++ runtime (newer there).
+for lib in $(ldd .devrun/bin/* | awk '/=>/ {print $3}' | sort -u); do
+  case $(basename "$lib") in libc.so*|libm.so*|libstdc++*|libgcc_s*|ld-linux*) ;; *) cp -L "$lib" .devrun/lib/ ;; esac
+done
+strip --strip-unneeded .devrun/lib/* 2>/dev/null || true
+tar -C .devrun -cJf .devrun/lib.tar.xz lib && rm -rf .devrun/lib
+echo libnvidia-opencl.so.1 >.devrun/icd/nvidia.icd
+data=${NARVAL_DATA_DIR:-../shared/data/volumes}
+[ -f "$data/wdas_cloud_sixteenth.vdb" ] && cp "$data/wdas_cloud_sixteenth.vdb" .devrun/data/
+du -sh .devrun
