@@ -69,9 +69,6 @@ for scene in $scenes; do
     echo
     continue
   fi
-  echo "## $scene at $resolution, $spp spp"
-  echo "device: $(field 's["device"]')"
-  echo
   # Counts (one run each) and warm-up of every program.
   declare -A perReal lookups cellText
   for c in $configs; do
@@ -81,6 +78,9 @@ for scene in $scenes; do
     cellText[$c]=$(field '"x".join(str(v) for v in s["majorant_cells"])')
     render "$scene" "$c"
   done
+  echo "## $scene at $resolution, $spp spp"
+  echo "device: $(field 's["device"]'), grid storage: $(field 's.get("storage", "?")')"
+  echo
   declare -A times
   for c in $configs; do times[$c]=""; done
   for _ in $(seq "$reps"); do

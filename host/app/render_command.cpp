@@ -1,5 +1,6 @@
 #include <filesystem>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -25,7 +26,7 @@ struct RenderArgs {
   std::string scene, out, algorithm, resolution, device, statsJson, localSize = "8x8";
   int spp = -1, bounces = -1, frames = 0, samplesPerPass = 0, majorantResolution = 0;
   bool resume = false, counters = false;
-  std::string majorant = "grid";
+  std::string majorant = "auto", storage;
   long long seed = -1;
   std::vector<std::string> sets;
 };
@@ -37,6 +38,7 @@ std::vector<std::string> overridesFrom(const RenderArgs& a) {
   if (a.bounces >= 0) o.push_back("renderer.bounces=" + std::to_string(a.bounces));
   if (a.seed >= 0) o.push_back("renderer.seed=" + std::to_string(a.seed));
   if (!a.algorithm.empty()) o.push_back("renderer.algorithm=\"" + a.algorithm + "\"");
+  if (!a.storage.empty()) o.push_back("renderer.storage=\"" + a.storage + "\"");
   if (!a.resolution.empty()) {
     const auto [w, h] = parseSize(a.resolution, "--resolution");
     o.push_back("renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]");
@@ -47,6 +49,7 @@ std::vector<std::string> overridesFrom(const RenderArgs& a) {
 nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
   return {{"algorithm", s.algorithm},
           {"device", s.device},
+          {"storage", s.storage},
           {"width", s.width},
           {"height", s.height},
           {"spp", s.spp},
@@ -81,6 +84,26 @@ nlohmann::json framesJson(const FrameTimings& f) {
           {"wall", {{"median", f.medianWallMs}, {"min", f.minWallMs}, {"max", f.maxWallMs}}}};
 }
 
+// --resume continues with the majorant the file at `out` was rendered with (its samples depend on
+// the majorant and, for the grid, on its cells): "auto" and resolution 0 take the file's; an explicit
+// choice that differs is a usage error. Files without the attributes (older renders) are left alone.
+void resumeMajorant(const std::string& out, const RenderArgs& a, std::string* majorant, int* resolution) {
+  const auto attrs = readExrAttributes(out);
+  const auto m = attrs.find("narval:majorant");
+  if (m == attrs.end() || m->second.empty()) return;
+  if (a.majorant != "auto" && a.majorant != m->second)
+    throw inputError("--majorant", "", out + " was rendered with --majorant " + m->second +
+                                           "; resume with it (or leave --majorant out)");
+  *majorant = m->second;
+  const auto r = attrs.find("narval:majorant_resolution");
+  if (m->second != "grid" || r == attrs.end()) return;
+  const int fileResolution = std::atoi(r->second.c_str());
+  if (a.majorantResolution != 0 && a.majorantResolution != fileResolution)
+    throw inputError("--majorant-resolution", "", out + " was rendered with --majorant-resolution " + r->second +
+                                                      "; resume with it (or leave it out)");
+  *resolution = fileResolution;
+}
+
 int runRender(const RenderArgs& a) {
   Scene scene = loadScene(a.scene, overridesFrom(a));
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
@@ -95,6 +118,8 @@ int runRender(const RenderArgs& a) {
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
 
   // --resume: the accumulator of an earlier render of the same settings at the output path.
+  std::string majorant = a.majorant;
+  int majorantResolution = a.majorantResolution;
   AccumulatorState resumeState;
   bool resuming = false;
   if (a.resume) {
@@ -102,6 +127,7 @@ int runRender(const RenderArgs& a) {
     if (fs::exists(out)) {
       resumeState = readAccumulator(out.string(), scene);
       resuming = true;
+      resumeMajorant(out.string(), a, &majorant, &majorantResolution);
       if (resumeState.samples == scene.renderer.spp) {
         std::cout << out.string() << " already has " << resumeState.samples << " spp; nothing to render\n";
         return 0;
@@ -130,8 +156,8 @@ int runRender(const RenderArgs& a) {
     scene.renderer.spp = a.frames;
     options.samplesPerPass = 1;
   }
-  options.majorant = a.majorant;
-  options.majorantResolution = a.majorantResolution;
+  options.majorant = majorant;
+  options.majorantResolution = majorantResolution;
   options.counters = a.counters;
   const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)
                                   : renderPathtrace(rt, scene, g, options);
@@ -199,6 +225,10 @@ Command addRenderCommand(CLI::App& app) {
                   "Render K frames and report ms per frame (pathtrace: K passes of 1 spp)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--stats-json", a->statsJson, "Write render statistics as JSON");
+  sub->add_option("--storage", a->storage,
+                  "Density grid on the device: image (3D image, hardware sampler), buffer (float buffer, the "
+                  "shared trilinear filter) or auto (buffer on CPUs, image on GPUs); renderer.storage")
+      ->check(CLI::IsMember({"auto", "image", "buffer"}));
   sub->add_option("--local-size", a->localSize, "Work-group shape WxH (default 8x8); never changes the pixels");
   sub->add_option("--samples-per-pass", a->samplesPerPass,
                   "pathtrace: samples per pixel per launch (default: about 2^20 paths per launch); never "
@@ -206,8 +236,8 @@ Command addRenderCommand(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   sub->add_option("--majorant", a->majorant,
                   "pathtrace: majorant of delta and ratio tracking: grid (per cell of a coarse grid, walked by "
-                  "DDA; default) or global (one for the whole medium)")
-      ->check(CLI::IsMember({"grid", "global"}));
+                  "DDA), global (one for the whole medium), or auto (default: grid on CPUs, global on GPUs)")
+      ->check(CLI::IsMember({"auto", "grid", "global"}));
   sub->add_option("--majorant-resolution", a->majorantResolution,
                   "Majorant grid cells along the grid's longest axis (0: automatic)")
       ->check(CLI::NonNegativeNumber);

@@ -1,6 +1,15 @@
 // majorant_options.h: RenderOptions' majorant choices (majorant, majorantResolution, counters)
 // applied to a scene on the device: the majorant grid's resolution, re-uploaded when it changes, and
 // the path tracer's -D options (kernels/shared/tracking.h: -DMAJORANT_GLOBAL, -DCOUNTERS).
+//
+// Defaults, by measurement (bench/majorant.sh; numbers in bench/RESULTS.md):
+// - majorant "auto": the grid on CPU devices (PoCL, Disney cloud: 2.6x faster than the global
+//   majorant at 16 cells, 3.6x at 32; the generated cloud 1.4x), the global majorant on GPUs (H100:
+//   a DDA cell step costs about what a hardware-filtered lookup saves: Disney 1.0x, generated cloud
+//   0.6x with the grid at 16 cells, worse with more cells).
+// - the path tracer's automatic resolution: 32 cells along the longest axis on CPUs (best or tied on
+//   both clouds), 16 elsewhere (where finer grids cost more); the real-time kernels keep
+//   buildDeviceScene's kDefaultMajorantResolution (16).
 #pragma once
 
 #include <string>
@@ -11,17 +20,24 @@
 
 namespace narval {
 
-// Throws std::invalid_argument for a majorant other than "grid" or "global" or a negative resolution.
+// Throws std::invalid_argument for a majorant other than "auto", "grid" or "global", or a negative
+// resolution.
 void checkMajorantOptions(const RenderOptions& options);
 
-// Rebuilds dev's majorant grid at options.majorantResolution (0: keeps the automatic one) and, if
-// it changed, replaces the scene and majorant-cell buffers on the device. Fills stats.majorantCells.
-void applyMajorantResolution(ClRuntime& rt, DeviceSceneBuffers& dev, const RenderOptions& options,
-                             RenderStats& stats);
+// "grid" or "global": `requested` ("auto", "grid", "global") for the device (see above).
+std::string resolveMajorant(const std::string& requested, const DeviceInfo& device);
 
-// The path tracer's extra build options: "-DMAJORANT_GLOBAL" for the global majorant, "-DCOUNTERS"
-// with counters, space-separated ("" for the default grid without counters).
-std::string pathtraceMajorantBuildOptions(const RenderOptions& options);
+// The path tracer's automatic majorant resolution on the device (see above).
+int pathtraceMajorantResolution(const DeviceInfo& device);
+
+// Rebuilds dev's majorant grid at `target` cells along the longest axis (0: keeps the one
+// buildDeviceScene made) and, if it changed, replaces the scene and majorant-cell buffers on the
+// device. Fills stats.majorantCells.
+void applyMajorantResolution(ClRuntime& rt, DeviceSceneBuffers& dev, int target, RenderStats& stats);
+
+// The path tracer's extra build options for a resolved majorant ("grid" or "global") and counters:
+// "-DMAJORANT_GLOBAL", "-DCOUNTERS", space-separated ("" for the grid without counters).
+std::string pathtraceMajorantBuildOptions(const std::string& majorant, bool counters);
 
 // `base` and `extra` joined by a space (either may be empty).
 std::string joinBuildOptions(const std::string& base, const std::string& extra);

@@ -40,13 +40,17 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   result.warnings = dev.scene.warnings;
   result.stats = initialStats("pathtrace", rt, scene);
   RenderStats& st = result.stats;
-  st.majorant = options.majorant;
+  st.majorant = resolveMajorant(options.majorant, rt.selected.info);
   st.counters = options.counters;
-  applyMajorantResolution(rt, dev, options, st);
+  applyMajorantResolution(rt, dev,
+                          options.majorantResolution > 0 ? options.majorantResolution
+                                                         : pathtraceMajorantResolution(rt.selected.info),
+                          st);
 
-  cl::Program program = buildProgram(rt, "pathtrace.cl",
-                                     joinBuildOptions(dev.scene.buildOptions, pathtraceMajorantBuildOptions(options)),
-                                     nullptr, &st.programFromCache);
+  cl::Program program = buildProgram(
+      rt, "pathtrace.cl",
+      joinBuildOptions(dev.scene.buildOptions, pathtraceMajorantBuildOptions(st.majorant, options.counters)), nullptr,
+      &st.programFromCache);
   cl::Kernel kernel(program, "pathtrace");
 
   const AllocationSite site{scene.sourcePath, "renderer.resolution",

@@ -42,8 +42,9 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   result.warnings = dev.scene.warnings;
   result.stats = initialStats(algorithm, rt, scene);
   RenderStats& st = result.stats;
+  recordGridStorage(st, dev);
   st.majorant = "grid";  // the marches always skip empty cells (march.h); options.majorant is the path tracer's
-  applyMajorantResolution(rt, dev, options, st);
+  applyMajorantResolution(rt, dev, options.majorantResolution, st);
   st.spp = st.sppRequested = 1;
 
   const realtime_params params = realtimeParams(scene);

@@ -20,6 +20,13 @@ RenderStats initialStats(const std::string& algorithm, const ClRuntime& rt, cons
   return st;
 }
 
+void recordGridStorage(RenderStats& st, const DeviceSceneBuffers& dev) {
+  st.storage = gridStorageName(dev.storage);
+  st.gridBytes = dev.scene.grid ? dev.scene.gridBytes : 0;
+  st.bricks = dev.bricks;
+  st.bricksOccupied = dev.bricksOccupied;
+}
+
 cl::NDRange localRange(const RenderOptions& o) {
   return cl::NDRange(size_t(std::max(1, o.localSizeX)), size_t(std::max(1, o.localSizeY)));
 }
@@ -76,7 +83,7 @@ double eventSeconds(const cl::Event& e) {
 
 size_t deviceSceneBytes(const DeviceScene& scene) {
   return sizeof(scene_params) + scene.lights.size() * sizeof(light_params) + scene.majorants.size() * sizeof(float) +
-         (scene.grid ? scene.grid->voxelCount() * sizeof(float) : 0);
+         (!scene.grid ? 0 : scene.gridBytes ? scene.gridBytes : scene.grid->voxelCount() * sizeof(float));
 }
 
 cl::Event launchAndWait(ClRuntime& rt, const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local,

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cl/cl_runtime.h"
+#include "render/device_scene.h"
 #include "render/render_types.h"
 #include "render/scene_upload.h"
 #include "scene/scene.h"
@@ -13,6 +14,10 @@ namespace narval {
 
 // Statistics with the fields every algorithm fills the same way.
 RenderStats initialStats(const std::string& algorithm, const ClRuntime& rt, const Scene& scene);
+
+// The grid storage `dev` chose (auto may fall back to bricks for a large grid) and its size on the
+// device, into `st` (storage, gridBytes, bricks, bricksOccupied).
+void recordGridStorage(RenderStats& st, const DeviceSceneBuffers& dev);
 
 // OpenCL 1.2 wants the global size to be a multiple of the local size: pad; kernels guard.
 cl::NDRange paddedGlobalRange(int width, int height, const RenderOptions& options);

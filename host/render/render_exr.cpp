@@ -47,7 +47,10 @@ std::vector<std::pair<std::string, std::string>> renderAttributes(const RenderSt
           {"narval:device", s.device},
           {"narval:seconds", std::to_string(s.seconds)},
           {"narval:status", std::to_string(s.status)},
-          {"narval:render_key", renderKey(scene)}};
+          {"narval:render_key", renderKey(scene)},
+          // The path tracer's samples also depend on these (RenderOptions): --resume keeps them.
+          {"narval:majorant", s.majorant},
+          {"narval:majorant_resolution", std::to_string(s.majorantResolution)}};
 }
 
 void writeRenderExr(const std::string& path, const RenderResult& r, const Scene& scene) {

@@ -30,11 +30,13 @@ struct RenderOptions {
   // pathtrace: continue from this state (same scene, size and seed) instead of from zero.
   const AccumulatorState* resumeFrom = nullptr;
   // pathtrace: the majorant delta and ratio tracking sample against (kernels/shared/tracking.h):
-  // "grid" (per cell of the majorant grid, walked by DDA) or "global" (one σ̄ over the box). Each is
-  // its own kernel build; both are unbiased and deterministic, with different random streams.
-  std::string majorant = "grid";
-  // Majorant grid cells along the grid's longest axis (chooseMajorantResolution); 0 = automatic.
-  // Also the real-time kernels' empty-space skipping granularity.
+  // "grid" (per cell of the majorant grid, walked by DDA), "global" (one σ̄ over the box), or "auto"
+  // (by device type, measured: render/majorant_options.h). Each is its own kernel build; both are
+  // unbiased and deterministic, with different random streams.
+  std::string majorant = "auto";
+  // Majorant grid cells along the grid's longest axis (chooseMajorantResolution); 0 = automatic
+  // (path tracer: pathtraceMajorantResolution; real-time kernels: kDefaultMajorantResolution). Also
+  // the real-time kernels' empty-space skipping granularity.
   int majorantResolution = 0;
   // pathtrace: build with -DCOUNTERS and report collision and lookup counts in RenderStats.
   bool counters = false;
@@ -51,10 +53,13 @@ struct FrameTimings {
 
 struct RenderStats {
   std::string algorithm, device;
-  // Grid storage the kernels were built for, "image" or "buffer": renderer.storage resolved for the
-  // device (resolveGridStorage, as DeviceSceneBuffers::storage); shown even when the medium has no
-  // grid to store.
+  // Grid storage the kernels were built for, "image", "buffer" or "bricks": renderer.storage
+  // resolved for the device and the grid (DeviceSceneBuffers::storage, recordGridStorage in
+  // render_common.h); shown even when the medium has no grid to store.
   std::string storage;
+  // The grid on the device: bytes in its storage (0 without a grid); with bricks, how many 8³ bricks
+  // the grid has and how many hold density (the pool).
+  size_t gridBytes = 0, bricks = 0, bricksOccupied = 0;
   int width = 0, height = 0, bounces = 0;
   int spp = 0;                 // samples per pixel in the image (pathtrace: resumed ones included)
   int sppRequested = 0;        // what the scene asked for; more than spp when interrupted
@@ -73,6 +78,7 @@ struct RenderStats {
   // with the grid) and the majorant grid's cells per axis (0 0 0 without a grid).
   std::string majorant;
   int majorantCells[3] = {0, 0, 0};
+  int majorantResolution = 0;  // the target the cells were built for (chooseMajorantResolution); 0: no grid
   // RenderOptions::counters (pathtrace): sums over all pixels of this run's samples (not those of a
   // resumed state): delta/spectral-tracking tentative collisions, real (absorbing or scattering)
   // collisions, density lookups of delta and ratio tracking (kernels/shared/tracking.h).

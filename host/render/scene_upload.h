@@ -18,6 +18,9 @@ struct DeviceScene {
   // Per-cell density bounds of the majorant grid (medium.majorant_grid): one cell of 1 for a
   // homogeneous medium, one cell of 0 without a medium.
   std::vector<float> majorants;
+  // Bytes the grid takes on the device in its storage (render/device_scene.h sets it at upload);
+  // 0 before the upload (deviceSceneBytes then counts the dense floats).
+  size_t gridBytes = 0;
   std::string buildOptions;         // -D defines for this scene
   std::vector<std::string> warnings;
 };

@@ -61,11 +61,13 @@ struct Camera {
 enum class ToneMapping { None, Reinhard, Aces };
 
 // How the density grid lives on the device (kernels/shared/grid.h): a 3D image read with the
-// hardware sampler, or a float buffer filtered by hand (kernels/shared/grid.h's grid_trilinear).
-// Auto: the buffer on CPU devices (on PoCL 3-4x the image's lookups per second, 1.3-1.7x faster
-// renders) and on devices without image support, the image elsewhere (GPUs filter in hardware:
-// 1.1-1.5x faster renders on an H100). render/device_grid.h resolves it for a device.
-enum class GridStorage { Auto, Image, Buffer };
+// hardware sampler, a float buffer filtered by hand (kernels/shared/grid.h's grid_trilinear), or
+// sparse 8³ bricks with an index table (the same filter, bit for bit; only bricks holding density
+// take memory: grids beyond one image or buffer). Auto: the buffer on CPU devices (on PoCL 3-4x
+// the image's lookups per second, 1.3-1.7x faster renders) and on devices without image support,
+// the image elsewhere (GPUs filter in hardware: 1.1-1.5x faster renders on an H100); bricks, with a
+// warning, when that choice cannot hold the grid. render/device_grid.h resolves it.
+enum class GridStorage { Auto, Image, Buffer, Bricks };
 
 struct RaymarchSettings {
   int steps = 60;
@@ -118,7 +120,7 @@ Scene parseScene(const std::string& jsonText, const std::string& path,
                  const std::vector<std::string>& overrides = {});
 
 const char* toneMappingName(ToneMapping t);
-// "auto", "image" or "buffer": the scene file's spelling.
+// "auto", "image", "buffer" or "bricks": the scene file's spelling.
 const char* gridStorageName(GridStorage s);
 
 }  // namespace narval

@@ -47,8 +47,9 @@
 // |   exposure              | number, stops                   |     | 0           |                            |
 // |   algorithm             | pathtrace, raymarch, lobe       |     | pathtrace   |                            |
 // |   seed                  | integer                         |     | 0           | [0, 2^32 - 1]              |
-// |   storage               | auto, image, buffer: the grid   |     | auto        | auto: buffer on CPU        |
-// |                         | on the device (--storage)       |     |             | devices, image elsewhere   |
+// |   storage               | auto, image, buffer, bricks:    |     | auto        | auto: buffer on CPU        |
+// |                         | the grid on the device          |     |             | devices, image elsewhere;  |
+// |                         | (--storage)                     |     |             | bricks if those can't hold |
 // |   raymarch.steps        | integer                         |     | 60          | >= 1                       |
 // |   raymarch.shadowSteps  | integer                         |     | 10          | >= 1                       |
 // |   raymarch.octaves      | integer                         |     | 1           | [1, 16]; 1 = off           |
@@ -127,7 +128,8 @@ const EnumNames<ToneMapping> kToneMappings = {{"none", ToneMapping::None},
                                               {"aces", ToneMapping::Aces}};
 const EnumNames<GridStorage> kGridStorages = {{"auto", GridStorage::Auto},
                                               {"image", GridStorage::Image},
-                                              {"buffer", GridStorage::Buffer}};
+                                              {"buffer", GridStorage::Buffer},
+                                              {"bricks", GridStorage::Bricks}};
 const EnumNames<std::string> kAlgorithms = {{"pathtrace", "pathtrace"},
                                             {"raymarch", "raymarch"},
                                             {"lobe", "lobe"}};

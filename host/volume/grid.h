@@ -24,6 +24,13 @@ struct DenseGrid {
   size_t voxelCount() const { return size_t(nx) * size_t(ny) * size_t(nz); }
 };
 
+// The largest grid held densely on the host: 8 GiB of floats (1290³, or 2048×2048×512). Loaders
+// and the cloud generator refuse larger grids with an error naming the size. On the device such a
+// grid goes to sparse bricks when one image or buffer cannot hold it (render/device_grid.h); the
+// host copy stays dense (the majorant grid is built from it), so a render holds it once, plus the
+// occupied bricks on the device.
+constexpr uint64_t kMaxDenseGridBytes = uint64_t(8) << 30;
+
 // Loads `path` by extension (.vdb: FloatGrid `gridName`; .vol: text). Throws InputError naming the
 // file on anything wrong (missing file, missing grid with the list of grids present, bad data).
 DenseGrid loadGrid(const std::string& path, const std::string& gridName = "density");
@@ -50,7 +57,8 @@ void writeVdb(const std::string& path, const DenseGrid& grid, const std::string&
 
 // Test support (lives in vdb_io.cpp so tests need not include OpenVDB): writes a small .vdb that
 // exercises one loader path. kind: "vec3" (Vec3SGrid "velocity" + FloatGrid "heat"), "frustum"
-// (FloatGrid "density" under a frustum map), "huge" (two active voxels 1024 apart: a 1024^3 box),
+// (FloatGrid "density" under a frustum map), "huge" (two active voxels 2047 apart: a 2048^3 box,
+// 32 GiB as dense floats),
 // "empty" (FloatGrid "density" without active voxels), "invalid" (FloatGrid "density", active
 // (0..3, 0, 0) = 1, NaN, -1, +inf), "affine" (voxels (3,4,5)..(4,6,8) holding
 // x + 10y + 100z, transform translate(1,2,3) * rotateZ(30 deg) * scale(2,3,4)).

@@ -173,8 +173,11 @@ inline float smin(float a, float b, float k) {
 
 DenseGrid makeCloud(int resolution, uint32_t seed) {
   if (resolution < 8) throw std::invalid_argument("makeCloud: resolution must be at least 8");
-  if (int64_t(resolution) * resolution * resolution > (int64_t(1) << 31) / int64_t(sizeof(float))) {
-    throw std::invalid_argument("makeCloud: resolution " + std::to_string(resolution) + " exceeds 2 GiB of floats");
+  const uint64_t bytes = uint64_t(resolution) * uint64_t(resolution) * uint64_t(resolution) * sizeof(float);
+  if (bytes > kMaxDenseGridBytes) {
+    throw std::invalid_argument("makeCloud: resolution " + std::to_string(resolution) + " needs " +
+                                std::to_string(bytes >> 20) + " MiB of floats, over the " +
+                                std::to_string(kMaxDenseGridBytes >> 20) + " MiB limit of a dense grid");
   }
   const std::vector<Blob> blobs = placeBlobs(seed);
   const uint32_t noiseSeed = hash32(seed ^ 0xa136aaadu);

@@ -209,11 +209,13 @@ Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate
   // In 64 bits: a corrupt tree can span more than 2^31 voxels per axis (Coord::dim would wrap).
   const int64_t dim[3] = {int64_t(bbox.max().x()) - bbox.min().x() + 1, int64_t(bbox.max().y()) - bbox.min().y() + 1,
                           int64_t(bbox.max().z()) - bbox.min().z() + 1};
-  constexpr uint64_t kMaxBytes = uint64_t(1) << 31;
-  constexpr int64_t kMaxDim = int64_t(kMaxBytes / sizeof(float));
+  // Dims are ints, an x-y slice's voxel count too (grid_trilinear's stride), and the whole grid at
+  // most kMaxDenseGridBytes (volume/grid.h). Checked in this order, no product overflows.
+  constexpr int64_t kMaxDim = INT32_MAX;
+  constexpr uint64_t kMaxVoxels = kMaxDenseGridBytes / sizeof(float);
   const bool tooBig = dim[0] > kMaxDim || dim[1] > kMaxDim || dim[2] > kMaxDim ||
-                      uint64_t(dim[0]) * uint64_t(dim[1]) > kMaxBytes ||
-                      uint64_t(dim[0]) * uint64_t(dim[1]) * uint64_t(dim[2]) * sizeof(float) > kMaxBytes;
+                      uint64_t(dim[0]) * uint64_t(dim[1]) > uint64_t(kMaxDim) ||
+                      uint64_t(dim[0]) * uint64_t(dim[1]) * uint64_t(dim[2]) > kMaxVoxels;
   if (tooBig) {
     const bool showCount = dim[0] < (1 << 20) && dim[1] < (1 << 20) && dim[2] < (1 << 20);
     const uint64_t voxels = uint64_t(dim[0]) * uint64_t(dim[1]) * uint64_t(dim[2]);
@@ -222,7 +224,7 @@ Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate
                          (showCount ? " = " + std::to_string(voxels) + " voxels needs " +
                                           std::to_string((voxels * sizeof(float)) >> 20) + " MiB as dense floats,"
                                     : " is") +
-                         " over the 2048 MiB limit");
+                         " over the " + std::to_string(kMaxDenseGridBytes >> 20) + " MiB limit");
   }
 
   Decoded out;
@@ -379,7 +381,7 @@ bool decodeInChild(const std::string& path, const std::string& gridName, DenseGr
   const Decoded& d = rec.decoded;
   const uint64_t voxels = uint64_t(d.nx) * uint64_t(d.ny) * uint64_t(d.nz);
   struct stat st {};
-  if (d.nx <= 0 || d.ny <= 0 || d.nz <= 0 || voxels * sizeof(float) > (uint64_t(1) << 31) ||
+  if (d.nx <= 0 || d.ny <= 0 || d.nz <= 0 || voxels * sizeof(float) > kMaxDenseGridBytes ||
       ::fstat(mem.fd, &st) != 0 || uint64_t(st.st_size) != kDataOffset + voxels * sizeof(float)) {
     throw inputError(path, "grid", cannot + " (the reader process returned an inconsistent result)");
   }
@@ -388,10 +390,22 @@ bool decodeInChild(const std::string& path, const std::string& gridName, DenseGr
   out.nz = d.nz;
   out.indexToWorld = d.indexToWorld;
   out.fileTransformIsScaleTranslate = d.scaleTranslate;
-  out.data.resize(voxels);
+  // Copied out a slice at a time, each slice's pages released from the memfd (a hole punched)
+  // once copied: the grid is held about once, not twice (4 GiB, not 8, for a 1024³ grid).
+  out.data.clear();
+  out.data.reserve(voxels);
   void* map = ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_SHARED, mem.fd, 0);
   if (map == MAP_FAILED) throw inputError(path, "grid", cannot + " (cannot map the reader's result)");
-  std::memcpy(out.data.data(), static_cast<const char*>(map) + kDataOffset, voxels * sizeof(float));
+  const float* values = reinterpret_cast<const float*>(static_cast<const char*>(map) + kDataOffset);
+  constexpr size_t kSlice = size_t(64) << 20;  // bytes, a multiple of the page size
+  static_assert(kSlice % 4096 == 0 && kDataOffset % 4096 == 0, "holes are punched in whole pages");
+  for (size_t done = 0; done < voxels;) {
+    const size_t n = std::min<size_t>(kSlice / sizeof(float), voxels - done);
+    out.data.insert(out.data.end(), values + done, values + done + n);
+    ::fallocate(mem.fd, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, off_t(kDataOffset + done * sizeof(float)),
+                off_t(n * sizeof(float)));  // best effort: a kernel without it only keeps the memory longer
+    done += n;
+  }
   ::munmap(map, size_t(st.st_size));
   return true;
 }
@@ -509,7 +523,7 @@ void writeVdbTestFile(const std::string& path, const std::string& kind) {
   } else if (kind == "huge") {
     openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
     f->tree().setValue(openvdb::Coord(-10, -10, -10), 1.0f);
-    f->tree().setValue(openvdb::Coord(1013, 1013, 1013), 1.0f);
+    f->tree().setValue(openvdb::Coord(2037, 2037, 2037), 1.0f);
     f->setName("density");
     grids.push_back(f);
   } else if (kind == "empty") {

@@ -61,7 +61,8 @@
  * cell σ̄ = max-channel σt · cell value · MAJORANT_MARGIN (majorant.h, the cell value bounds the
  * trilinear density there). Global: one segment [t, t_max] with σ̄ = medium_params.majorant.
  * Chosen at build time, so neither kernel carries the other's branch:
- * - device: -DMAJORANT_GLOBAL selects the global majorant; MEDIUM_HOMOGENEOUS also takes it (its one
+ * - device: -DMAJORANT_GLOBAL selects the global majorant (the host passes it for --majorant global,
+ *   and for auto on GPUs: host/render/majorant_options.h); MEDIUM_HOMOGENEOUS also takes it (its one
  *   cell would give the same σ̄, without a DDA);
  * - host: -DMAJORANT_GLOBAL likewise, else the grid when the grid_view carries majorant cells and
  *   the medium has cells (a runtime test: host tests walk both ways in one binary).

@@ -1,5 +1,6 @@
 /* Test kernel: grid_density at a batch of index-space points, in the grid storage the program is
- * built for (-DGRID_STORAGE_BUFFER: the float buffer; otherwise the 3D image and its sampler). */
+ * built for (-DGRID_STORAGE_BUFFER: the float buffer; -DGRID_STORAGE_BRICKS: sparse bricks;
+ * otherwise the 3D image and its sampler). */
 #include "shared/grid.h"
 
 __kernel void grid_lookup(GRID_KERNEL_PARAM, __global const float4* points, __global float* out) {

@@ -1,5 +1,10 @@
-// grid_storage_lookup_test.cpp: one density lookup at a time, in both grid storages on the device
+// grid_storage_lookup_test.cpp: one density lookup at a time, in every grid storage on the device
 // (tests/device/grid_lookup.cl), against the host's grid_trilinear (kernels/shared/grid.h).
+//
+// Bricks storage: grid_bricks_trilinear reads the same eight corners as grid_trilinear (from one
+// brick and its apron) and sums them with the same grid_trilinear_combine, so on the device it
+// must equal the buffer storage bit for bit at every point (both are device code: no host
+// compiler in between).
 //
 // Buffer storage: the device runs grid_trilinear itself, the same operations in the same order
 // with FP_CONTRACT off (compat.h); only a host compiler that fuses multiply-adds could differ, by
@@ -33,6 +38,7 @@
 #include "render/device_grid.h"
 #include "shared/grid.h"
 #include "shared/structs.h"
+#include "volume/brick_grid.h"
 #include "volume/grid.h"
 
 namespace narval {
@@ -81,6 +87,18 @@ std::vector<nv_float4> lookupPoints(const DenseGrid& g, std::mt19937& rng, int r
         pts.push_back({x + 0.5f, y + 0.5f, z + 0.5f, 0});
         pts.push_back({float(x), y + 0.25f, z + 0.75f, 0});
       }
+  // Brick faces (8k) and the planes where a lookup moves to the next brick (8k + 0.5), ± a little,
+  // crossed with random points: the bricks storage's seams.
+  std::uniform_real_distribution<float> any(-1.0f, float(std::max({g.nx, g.ny, g.nz})) + 1.0f);
+  for (int k = 0; 8 * k <= std::max({g.nx, g.ny, g.nz}) + 1; ++k)
+    for (float d : {-0.5f, -1e-3f, 0.0f, 1e-3f, 0.25f, 0.5f, 0.501f, 0.75f, 1.0f})
+      for (int r = 0; r < 20; ++r) {
+        const float a = 8.0f * k + d, b = any(rng), c = any(rng);
+        pts.push_back({a, b, c, 0});
+        pts.push_back({b, a, c, 0});
+        pts.push_back({c, b, a, 0});
+        pts.push_back({a, a, c, 0});
+      }
   const float inf = std::numeric_limits<float>::infinity();
   for (float far : {1e30f, -1e30f, inf, -inf, 1e7f, -1.0f}) {
     pts.push_back({far, 1.0f, 1.0f, 0});
@@ -119,6 +137,9 @@ class GridStorageLookup : public testing::Test {
     if (storage == GridStorage::Buffer) {
       buffer = uploadGridBuffer(*rt_, g);
       k.setArg(0, buffer);
+    } else if (storage == GridStorage::Bricks) {
+      buffer = uploadGridBricks(*rt_, g, planBricks(g));
+      k.setArg(0, buffer);
     } else {
       image = uploadGridImage(*rt_, g);
       k.setArg(0, image);
@@ -138,6 +159,12 @@ class GridStorageLookup : public testing::Test {
     const std::vector<nv_float4> pts = lookupPoints(g, rng, 20000);
     const std::vector<float> buf = lookUp(g, GridStorage::Buffer, pts);
     const std::vector<float> img = lookUp(g, GridStorage::Image, pts);
+    const std::vector<float> bricks = lookUp(g, GridStorage::Bricks, pts);
+    size_t bricksDiffer = 0;
+    for (size_t i = 0; i < pts.size(); ++i)
+      if (std::memcmp(&bricks[i], &buf[i], sizeof(float)) != 0 && bricksDiffer++ < 5)
+        ADD_FAILURE() << name << ": bricks " << bricks[i] << ", buffer " << buf[i] << " at (" << pts[i].x << ", "
+                      << pts[i].y << ", " << pts[i].z << ")";
     const bool floatFilter = rt_->selected.info.type == "CPU";
     int64_t bufUlps = 0, imgUlps = 0;
     size_t bufIdentical = 0, bufBad = 0, imgBad = 0;
@@ -171,10 +198,12 @@ class GridStorageLookup : public testing::Test {
     s << name << ": " << pts.size() << " lookups; buffer vs host: " << bufIdentical << " bit-identical, max "
       << bufUlps << " ulp; image vs host: max " << imgUlps << " ulp, max relative " << imgRel << " ("
       << imgRel / kEps << " eps)";
+    s << "; bricks vs buffer: " << pts.size() - bricksDiffer << " bit-identical";
     std::cout << "[ grid storage ] " << s.str() << "\n";
     RecordProperty(name, s.str());
     EXPECT_EQ(bufBad, 0u) << "buffer lookups off the host by more than 4 ulps; first: " << firstBad;
     EXPECT_EQ(imgBad, 0u) << "image lookups outside the bound; first: " << firstBad;
+    EXPECT_EQ(bricksDiffer, 0u) << "bricks lookups that are not the buffer's bits";
   }
 
   static ClRuntime* rt_;
@@ -194,6 +223,35 @@ TEST_F(GridStorageLookup, DenseRandomGridMatchesTheHostInBothStorages) {
   for (size_t i = 0; i < g.voxelCount(); ++i) g.data.push_back(u(rng));
   g.maxValue = *std::max_element(g.data.begin(), g.data.end());
   check(g, "random 7x5x3");
+}
+
+// Sparse data for the bricks: a grid of 8³ bricks, most empty, whose only non-zero voxels sit on
+// brick corners and edges (carried to the neighbouring bricks by the apron) and on the far border.
+TEST_F(GridStorageLookup, SparseVoxelsOnBrickCornersMatchInEveryStorage) {
+  DenseGrid g;
+  g.nx = 26;
+  g.ny = 17;
+  g.nz = 20;
+  g.data.assign(g.voxelCount(), 0.0f);
+  auto set = [&](int x, int y, int z, float v) { g.data[size_t(x) + size_t(g.nx) * (size_t(y) + size_t(g.ny) * z)] = v; };
+  set(8, 8, 8, 3.0f);
+  set(16, 7, 8, 1.5f);
+  set(25, 16, 19, 2.0f);
+  set(0, 0, 0, 0.25f);
+  g.maxValue = 3.0f;
+  const BrickLayout layout = planBricks(g);
+  EXPECT_LT(layout.occupiedCount(), layout.brickCount());
+  check(g, "corner voxels 26x17x20");
+}
+
+TEST_F(GridStorageLookup, AllZeroGridReadsZeroInEveryStorage) {
+  DenseGrid g;
+  g.nx = 12;
+  g.ny = 9;
+  g.nz = 3;
+  g.data.assign(g.voxelCount(), 0.0f);
+  EXPECT_EQ(planBricks(g).occupiedCount(), 0u);
+  check(g, "all zero 12x9x3");
 }
 
 TEST_F(GridStorageLookup, OneVoxelGridMatchesTheHostInBothStorages) {

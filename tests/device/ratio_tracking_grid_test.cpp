@@ -23,6 +23,7 @@
 #include "scene/scene.h"
 #include "shared/grid.h"
 #include "shared/medium.h"
+#include "volume/brick_grid.h"
 #include "volume/grid.h"
 
 namespace narval {
@@ -74,6 +75,8 @@ void checkRatioTracking(GridStorage storage, bool globalMajorant) {
   cl::Buffer buffer;
   if (storage == GridStorage::Buffer)
     buffer = uploadGridBuffer(rt, cloud);
+  else if (storage == GridStorage::Bricks)
+    buffer = uploadGridBricks(rt, cloud, planBricks(cloud));
   else
     image = uploadGridImage(rt, cloud);
   // The scene's majorant cells (medium.majorant_grid says how many); the global build ignores them.
@@ -82,7 +85,7 @@ void checkRatioTracking(GridStorage storage, bool globalMajorant) {
   cl::Buffer cellsBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, ds.majorants.size() * sizeof(float),
                       const_cast<float*>(ds.majorants.data()));
   k.setArg(0, mBuf);
-  if (storage == GridStorage::Buffer)
+  if (storage == GridStorage::Buffer || storage == GridStorage::Bricks)
     k.setArg(1, buffer);
   else
     k.setArg(1, image);
@@ -97,7 +100,7 @@ void checkRatioTracking(GridStorage storage, bool globalMajorant) {
   cl::Kernel kd(program, "delta_escape_fraction");
   cl::Buffer fracBuf(rt.context, CL_MEM_WRITE_ONLY, numRays * sizeof(float));
   kd.setArg(0, mBuf);
-  if (storage == GridStorage::Buffer)
+  if (storage == GridStorage::Buffer || storage == GridStorage::Bricks)
     kd.setArg(1, buffer);
   else
     kd.setArg(1, image);
@@ -144,6 +147,9 @@ TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepthImageStorage) {
 }
 TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepthBufferStorage) {
   checkRatioTracking(GridStorage::Buffer, false);
+}
+TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepthBricksStorage) {
+  checkRatioTracking(GridStorage::Bricks, false);
 }
 TEST(RatioTrackingOnDevice, MatchesQuadratureOfOpticalDepthImageStorageGlobalMajorant) {
   checkRatioTracking(GridStorage::Image, true);

@@ -67,10 +67,11 @@ TEST(RenderAnalytic, WhiteFurnaceHomogeneousIsExactlyOne) {
   EXPECT_EQ(r.stats.status, 0u);
 }
 
-// On grids, in both grid storages (renderer.storage): the walk's decisions depend on the density,
-// the throughput never does, so the image filter's rounding cannot move a pixel off 1.
-void expectFurnaceExactlyOneInBothStorages(const DenseGrid& cloud) {
-  for (const GridStorage storage : {GridStorage::Image, GridStorage::Buffer}) {
+// On grids, in every grid storage (renderer.storage: image, buffer, bricks): the walk's decisions
+// depend on the density, the throughput never does, so the image filter's rounding cannot move a
+// pixel off 1, nor can the bricks' empty space.
+void expectFurnaceExactlyOneInEveryStorage(const DenseGrid& cloud) {
+  for (const GridStorage storage : {GridStorage::Image, GridStorage::Buffer, GridStorage::Bricks}) {
     SCOPED_TRACE(gridStorageName(storage));
     Scene scene = sceneFromJson(furnaceScene("", "[1, 1, 1]"));
     scene.renderer.storage = storage;
@@ -81,13 +82,13 @@ void expectFurnaceExactlyOneInBothStorages(const DenseGrid& cloud) {
 }
 
 TEST(RenderAnalytic, WhiteFurnaceOnGeneratedCloudIsExactlyOne) {
-  expectFurnaceExactlyOneInBothStorages(makeCloud(32, 7));
+  expectFurnaceExactlyOneInEveryStorage(makeCloud(32, 7));
 }
 
 TEST(RenderAnalytic, WhiteFurnaceOnDisneyCloudIsExactlyOne) {
   const std::string path = realDataPath("wdas_cloud_sixteenth.vdb");
   NARVAL_REQUIRE_REAL_DATA(path);
-  expectFurnaceExactlyOneInBothStorages(loadGrid(path, "density"));
+  expectFurnaceExactlyOneInEveryStorage(loadGrid(path, "density"));
 }
 
 // Chromatic white furnace: σs = (1, 2, 3)·D, σa = 0. Spectral tracking reweights the throughput, so

@@ -1,6 +1,8 @@
-// Grids the device cannot hold get a clear error naming the file and the limit; the image
-// storage's errors say when the buffer storage would hold the grid (bricked storage for larger
-// grids comes later: issue 6).
+// Grids the device cannot hold: a storage asked for by name (image, buffer, bricks) gives a clear
+// error naming the file, the limit and the storage that would hold the grid; renderer.storage
+// "auto" falls back to sparse bricks with a warning (issue 6, item 6) when its choice cannot hold
+// the grid. Lowered limits come from a copy of the runtime (same context and queue) whose
+// advertised DeviceInfo is changed.
 #include <gtest/gtest.h>
 
 #include <sstream>
@@ -55,6 +57,41 @@ TEST(DeviceLimits, GridWiderThanTheImageLimitRendersFromABuffer) {
   EXPECT_EQ(r.stats.nanPixels, 0);
 }
 
+// On a device that prefers images (advertised as a GPU), the grid wider than the 3D image limit
+// was an error; with renderer.storage "auto" it now renders from bricks, says so in a warning, and
+// gives the pixels of the buffer storage. With "image" asked for by name it is still the error.
+TEST(DeviceLimits, AutoFallsBackToBricksForAGridWiderThanTheImageLimit) {
+  ClRuntime gpu = runtime();
+  gpu.selected.info.type = "GPU";
+  gpu.selected.info.imageSupport = true;
+  const DenseGrid grid = wideGrid();
+  ASSERT_EQ(resolveGridStorage(GridStorage::Auto, gpu.selected.info), GridStorage::Image);
+  std::string why;
+  EXPECT_EQ(chooseGridStorage(GridStorage::Auto, gpu.selected.info, &grid, &why), GridStorage::Bricks);
+  std::ostringstream limit;
+  limit << "wide.vdb: grid " << grid.nx << "x1x1 exceeds the device's 3D image limit " << gpu.selected.info.image3dMax[0]
+        << "x" << gpu.selected.info.image3dMax[1] << "x" << gpu.selected.info.image3dMax[2]
+        << ": renderer.storage \"auto\" stores it as sparse 8^3 bricks (\"bricks\") instead of a 3D image";
+  EXPECT_EQ(why, limit.str());
+
+  Scene scene = sceneFromJson(absorptionBoxJson(R"({"resolution": [4, 4], "algorithm": "raymarch"})"));
+  const RenderResult r = renderRealtime(gpu, scene, &grid, 1, RenderOptions{});
+  EXPECT_EQ(r.stats.storage, "bricks");
+  EXPECT_EQ(r.stats.bricks, 257u);  // ceil(2049 / 8) x 1 x 1
+  EXPECT_EQ(r.stats.bricksOccupied, 257u);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_EQ(r.warnings[0], limit.str() + ": 257 of 257 bricks occupied (100.0%), " + byteCount(r.stats.gridBytes));
+  EXPECT_EQ(r.stats.status, 0u);
+  scene.renderer.storage = GridStorage::Buffer;
+  const RenderResult b = renderRealtime(gpu, scene, &grid, 1, RenderOptions{});
+  EXPECT_EQ(b.stats.storage, "buffer");
+  EXPECT_TRUE(b.warnings.empty());
+  EXPECT_EQ(r.image.rgb, b.image.rgb);
+
+  scene.renderer.storage = GridStorage::Image;
+  EXPECT_THROW(renderRealtime(gpu, scene, &grid, 1, RenderOptions{}), InputError);
+}
+
 // A buffer over CL_DEVICE_MAX_MEM_ALLOC_SIZE: refused before any allocation, naming the bytes.
 TEST(DeviceLimits, GridOverTheLargestAllocationIsAClearBufferError) {
   const DeviceInfo& d = runtime().selected.info;
@@ -67,7 +104,8 @@ TEST(DeviceLimits, GridOverTheLargestAllocationIsAClearBufferError) {
   std::ostringstream expected;
   expected << "huge.vdb: grid: grid " << grid.nx << "x" << grid.ny << "x" << grid.nz
            << " as a float buffer needs " << byteCount(bytes) << ", over device '" << d.name
-           << "''s largest allocation (CL_DEVICE_MAX_MEM_ALLOC_SIZE) of " << byteCount(d.maxAllocBytes);
+           << "''s largest allocation (CL_DEVICE_MAX_MEM_ALLOC_SIZE) of " << byteCount(d.maxAllocBytes)
+           << "; renderer.storage \"bricks\" (--storage bricks) stores only its non-empty 8^3 bricks";
   try {
     uploadGridBuffer(runtime(), grid);
     FAIL() << "expected InputError";

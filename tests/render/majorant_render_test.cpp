@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <string>
 
+#include "render/majorant_options.h"
 #include "render/scene_upload.h"
 #include "render_fixture.h"
 #include "test_support.h"
@@ -180,7 +181,7 @@ TEST(MajorantRender, EmptyCellsMakeNoLookups) {
   const DeviceScene ds = buildDeviceScene(scene, &grid);
   ASSERT_EQ(ds.params.medium.majorant_grid.cells_x, 16);
   for (const char* m : kModes) {
-    const RenderResult r = renderMajorant(scene, &grid, m, true);
+    const RenderResult r = renderMajorant(scene, &grid, m, true, 16);
     size_t wrong = 0;
     for (float v : r.image.rgb) wrong += v != 1.0f;
     EXPECT_EQ(wrong, 0u) << m;
@@ -222,19 +223,23 @@ TEST(MajorantRender, CountersChangeNoPixelAndShowTheGridsSaving) {
 }
 
 // RenderOptions::majorantResolution reaches the kernels: the stats report the cells
-// chooseMajorantResolution gives for it (0: the automatic choice), and the pixels stay exact in the
-// furnace (above). Here on the generated cloud: 8 and 32 against the automatic 16.
+// chooseMajorantResolution gives for it (0: the path tracer's automatic choice for the device,
+// pathtraceMajorantResolution), and the pixels stay exact in the furnace (above). Here on the
+// generated cloud (32³): 8 and 24 besides the automatic one. "auto" resolves by device type.
 TEST(MajorantRender, ResolutionOverride) {
   const DenseGrid cloud = makeCloud(32, 5);
   Scene scene = sceneFromJson(kLitCloud);
   scene.renderer.spp = 1;
-  for (const int res : {0, 8, 32}) {
+  const DeviceInfo& device = runtime().selected.info;
+  for (const int res : {0, 8, 24}) {
     const RenderResult r = renderMajorant(scene, &cloud, "grid", false, res);
-    const std::array<int, 3> want = chooseMajorantResolution(32, 32, 32, res == 0 ? kDefaultMajorantResolution : res);
+    const int target = res == 0 ? pathtraceMajorantResolution(device) : res;
+    const std::array<int, 3> want = chooseMajorantResolution(32, 32, 32, target);
     EXPECT_EQ(r.stats.majorantCells[0], want[0]) << res;
     EXPECT_EQ(r.stats.majorantCells[1], want[1]) << res;
     EXPECT_EQ(r.stats.majorantCells[2], want[2]) << res;
   }
+  EXPECT_EQ(renderMajorant(scene, &cloud, "auto").stats.majorant, device.type == "GPU" ? "global" : "grid");
 }
 
 }  // namespace

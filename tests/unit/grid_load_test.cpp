@@ -315,8 +315,8 @@ TEST(VdbErrors, FrustumEmptyAndOversizedGrids) {
   // The size is refused from the bounding box, before any dense allocation (that is what the
   // message reports: the box, not a failed allocation).
   EXPECT_EQ(errorOf([&] { narval::loadVdb(huge, "density"); }),
-            huge + ": grid: 'density' active bounding box 1024x1024x1024 = 1073741824 voxels needs 4096 MiB as "
-                   "dense floats, over the 2048 MiB limit");
+            huge + ": grid: 'density' active bounding box 2048x2048x2048 = 8589934592 voxels needs 32768 MiB as "
+                   "dense floats, over the 8192 MiB limit");
 }
 
 TEST(VdbTransform, AffineMapIsComposedWithTheBoundingBoxShift) {

@@ -325,7 +325,7 @@ TEST(SceneErrors, BadValuesNameFileKeyAndProblem) {
       {"/materials/1/gridSpace", "world", "s.json: materials[1].gridSpace: unknown value \"world\" (allowed: unit, file)"},
       {"/primitives/1/type", "sphere", "s.json: primitives[1].type: unknown value \"sphere\" (allowed: rectangle, volume, point)"},
       {"/renderer/algorithm", "mlt", "s.json: renderer.algorithm: unknown value \"mlt\" (allowed: pathtrace, raymarch, lobe)"},
-      {"/renderer/storage", "texture", "s.json: renderer.storage: unknown value \"texture\" (allowed: auto, image, buffer)"},
+      {"/renderer/storage", "texture", "s.json: renderer.storage: unknown value \"texture\" (allowed: auto, image, buffer, bricks)"},
       {"/renderer/storage", true, "s.json: renderer.storage: expected a string, got boolean"},
       {"/renderer/toneMapping", "filmic", "s.json: renderer.toneMapping: unknown value \"filmic\" (allowed: none, reinhard, aces)"},
       // out of range
@@ -460,6 +460,16 @@ TEST(SceneOverrides, ReplaceCreateAndParseValues) {
   EXPECT_EQ(s.renderer.toneMapping, ToneMapping::None);
   EXPECT_EQ(s.camera.position, (Vec3f{0, 0, -9}));
   EXPECT_EQ(s.renderer.storage, GridStorage::Buffer);
+}
+
+// renderer.storage takes every storage by its name, and gridStorageName spells it back.
+TEST(SceneOverrides, EveryGridStorageParsesByName) {
+  for (const char* name : {"auto", "image", "buffer", "bricks"}) {
+    const Scene s = parseScene(minimalScene().dump(), "s.json", {std::string("renderer.storage=") + name});
+    EXPECT_STREQ(gridStorageName(s.renderer.storage), name);
+  }
+  EXPECT_EQ(parseScene(minimalScene().dump(), "s.json", {"renderer.storage=bricks"}).renderer.storage,
+            GridStorage::Bricks);
 }
 
 TEST(SceneOverrides, OverriddenValuesAreValidated) {
