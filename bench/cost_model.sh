@@ -117,11 +117,13 @@ run() {
   fi
   times >"$work/c1"
   t1=$(date +%s%N)
-  printf '{"algorithm": "%s", "factor": "%s", "x": %s, "rep": %s, "counters": %s, "wall": %s, "cpu_before": "%s", "cpu_after": "%s", "options": "%s", "stats": ' \
-    "$algo" "$factor" "$x" "$rep" "$counters" "$(( (t1 - t0) / 1000 ))e-6" "$(sed -n 2p "$work/c0")" \
-    "$(sed -n 2p "$work/c1")" "$*" >>"$raw"
-  cat "$work/s.json" >>"$raw"
-  echo "}" >>"$raw"
+  {
+    printf '{"algorithm": "%s", "factor": "%s", "x": %s, "rep": %s, "counters": %s, "wall": %s, "cpu_before": "%s", "cpu_after": "%s", "options": "%s", "stats": ' \
+      "$algo" "$factor" "$x" "$rep" "$counters" "$(( (t1 - t0) / 1000 ))e-6" "$(sed -n 2p "$work/c0")" \
+      "$(sed -n 2p "$work/c1")" "$*"
+    cat "$work/s.json"
+    echo "}"
+  } >>"$raw"
 }
 
 # Series: each line "X OPTIONS..." (the base configuration with one option varied).
