@@ -158,7 +158,7 @@ for c in "${cases[@]}"; do
     pc="" nc=""
     same=$(python3 -c 'import json,sys; a,b=(json.load(open(f)) for f in sys.argv[1:]); print(int(a["majorant_cells"]==b["majorant_cells"]))' \
            "$work/$tag-pocl.json" "$work/$tag-native.json")
-    if [ "$same" != 1 ]; then
+    if [ "$same" != 1 ] && [ "$cells" -gt 1 ]; then
       echo "warning: $tag: PoCL and native majorant grids differ ($(json "$work/$tag-pocl.json" 'j["majorant_cells"]') vs" \
            "$(json "$work/$tag-native.json" 'j["majorant_cells"]')): not the same work" >&2
     fi

@@ -146,6 +146,8 @@ int run(const Args& a) {
             {"narval:seed", std::to_string(scene.renderer.seed)},
             {"narval:device", device}});
 
+  const majorant_grid_params& mg = ds.params.medium.majorant_grid;
+  const std::vector<int> cells = ds.grid ? std::vector<int>{mg.cells_x, mg.cells_y, mg.cells_z} : std::vector<int>{0, 0, 0};
   nlohmann::ordered_json j = {{"algorithm", alg},
                               {"device", device},
                               {"threads", r.threads},
@@ -156,9 +158,7 @@ int run(const Args& a) {
                               {"bounces", ds.params.max_bounces},
                               {"seed", scene.renderer.seed},
                               {"majorant", alg == "pathtrace" ? o.majorant : std::string("grid")},
-                              {"majorant_cells",
-                               {ds.params.medium.majorant_grid.cells_x, ds.params.medium.majorant_grid.cells_y,
-                                ds.params.medium.majorant_grid.cells_z}},
+                              {"majorant_cells", cells},  // as narval render reports them: 0 0 0 without a grid
                               {"seconds", seconds},
                               {"samples_per_second", double(W) * H * spp / seconds},
                               {"nan_pixels", r.nanPixels},
@@ -199,7 +199,10 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--majorant", a.majorant, "pathtrace: grid (default) | global | auto (grid: what narval picks for CPUs)")
       ->check(CLI::IsMember({"grid", "global", "auto"}));
-  app.add_option("--majorant-resolution", a.majorantResolution, "Majorant cells along the longest axis (0: automatic)")
+  app.add_option("--majorant-resolution", a.majorantResolution,
+                 "Majorant cells along the longest axis (0: buildDeviceScene's automatic choice; narval render "
+                 "may choose otherwise per device: give what its --stats-json majorant_cells says, as "
+                 "bench/native_baseline.sh does)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--stats-json", a.statsJson, "Also write the JSON to FILE");
   app.add_option("--compare", a.compare, "Compare bit for bit with REF.exr (e.g. the PoCL render)");
