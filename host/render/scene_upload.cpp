@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "render/kernel_features.h"
 #include "scene/input_error.h"
 #include "volume/majorant_grid.h"
 
@@ -223,6 +224,10 @@ DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
   sp.num_lights = int(ds.lights.size());
   if (ds.lights.empty()) ds.lights.push_back(light_params{});  // a buffer may not be empty
   ds.buildOptions = (!sp.has_medium || !grid) ? "-DMEDIUM_HOMOGENEOUS" : "";
+  if (kernelSpecialisationEnabled()) {  // render/kernel_features.h
+    const std::string features = sceneFeatureOptions(ds);
+    if (!features.empty()) ds.buildOptions += (ds.buildOptions.empty() ? "" : " ") + features;
+  }
   return ds;
 }
 

@@ -7,6 +7,14 @@
 #include "shared/sampling.h"
 #include "shared/structs.h"
 
+/* -DCAMERA_PINHOLE (scene specialisation, host/render/kernel_features.h): the host sets it when
+ * lens_radius is not positive, which the runtime test would also take as a pinhole; bit for bit. */
+#ifdef CAMERA_PINHOLE
+#define CAMERA_HAS_LENS(c) 0
+#else
+#define CAMERA_HAS_LENS(c) ((c)->lens_radius > 0.0f)
+#endif
+
 typedef struct ray3 {
   vec3 origin;
   vec3 dir; /* unit length */
@@ -19,7 +27,7 @@ static inline ray3 camera_ray(NV_CONSTANT const camera_params* c, float px, floa
   const vec3 fwd = vec3_from4(c->forward), right = vec3_from4(c->right), up = vec3_from4(c->up);
   vec3 dir = vec3_normalize(vec3_add(fwd, vec3_add(vec3_scale(right, sx), vec3_scale(up, sy))));
   vec3 origin = vec3_from4(c->position);
-  if (c->lens_radius > 0.0f) {
+  if (CAMERA_HAS_LENS(c)) {
     float lx, ly;
     sample_concentric_disk(lens_u, lens_v, &lx, &ly);
     const vec3 focus = vec3_madd(origin, dir, c->focus_distance / vec3_dot(dir, fwd));

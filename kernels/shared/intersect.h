@@ -4,6 +4,18 @@
 
 #include "shared/structs.h"
 
+/* Light kinds (scene specialisation, host/render/kernel_features.h): -DLIGHTS_POINT_ONLY when the
+ * scene has no rectangle light (point lights or none), -DLIGHTS_RECT_ONLY when all its lights are
+ * rectangles; the type tests fold and, with points only, intersect_lights returns "no hit" without
+ * looping. Same arithmetic as the generic kernel. Neither: the runtime light_params.type. */
+#if defined(LIGHTS_POINT_ONLY)
+#define LIGHT_IS_RECT(l) 0
+#elif defined(LIGHTS_RECT_ONLY)
+#define LIGHT_IS_RECT(l) 1
+#else
+#define LIGHT_IS_RECT(l) ((l)->type == LIGHT_RECTANGLE)
+#endif
+
 /* Slab test of o + t·d against the box [0, hi]. Returns 1 and the parametric interval when the ray
  * line meets the box. A zero direction component gives ±inf slab bounds (IEEE); fmin/fmax discard
  * the NaN that 0·inf produces for an origin exactly on a slab plane. */
@@ -41,8 +53,10 @@ static inline int intersect_lights(NV_CONSTANT const light_params* lights, int n
                                    float t_min, int skip, NV_PRIVATE float* t_hit, NV_PRIVATE int* front) {
   int hit = -1;
   *t_hit = NV_INFINITY;
+#ifndef LIGHTS_POINT_ONLY /* else no rectangles: nothing to hit */
   for (int i = 0; i < num_lights; ++i) {
-    if (i == skip || lights[i].type != LIGHT_RECTANGLE) continue;
+    if (i == skip) continue;
+    if (!LIGHT_IS_RECT(&lights[i])) continue;
     int f = 0;
     const float t = intersect_rectangle(&lights[i], o, d, t_min, &f);
     if (t < *t_hit) {
@@ -51,6 +65,7 @@ static inline int intersect_lights(NV_CONSTANT const light_params* lights, int n
       hit = i;
     }
   }
+#endif
   return hit;
 }
 

@@ -16,14 +16,14 @@ typedef struct light_sample {
 static inline int light_sample_point(NV_CONSTANT const light_params* l, vec3 x, float u1, float u2,
                                      NV_PRIVATE light_sample* s) {
   vec3 y = vec3_from4(l->corner);
-  if (l->type == LIGHT_RECTANGLE)
+  if (LIGHT_IS_RECT(l))
     y = vec3_add(y, vec3_add(vec3_scale(vec3_from4(l->edge_u), u1), vec3_scale(vec3_from4(l->edge_v), u2)));
   const vec3 to = vec3_sub(y, x);
   const float d2 = vec3_dot(to, to);
   if (!(d2 > 0.0f)) return 0;
   s->dist = nv_sqrt(d2);
   s->dir = vec3_scale(to, 1.0f / s->dist);
-  if (l->type == LIGHT_POINT) {
+  if (!LIGHT_IS_RECT(l)) {
     s->radiance = vec3_scale(vec3_from4(l->radiance), 1.0f / d2);
     s->pdf = 0.0f;
     return 1;

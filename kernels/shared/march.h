@@ -118,14 +118,14 @@ static inline int march_light_as_point(NV_CONSTANT const light_params* l, vec3 x
                                        NV_PRIVATE float* dist, NV_PRIVATE vec3* intensity) {
   vec3 p = vec3_from4(l->corner);
   vec3 I = vec3_from4(l->radiance);
-  if (l->type == LIGHT_RECTANGLE)
+  if (LIGHT_IS_RECT(l))
     p = vec3_add(p, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
   const vec3 to = vec3_sub(p, x);
   const float d2 = vec3_dot(to, to);
   if (!(d2 > 0.0f)) return 0;
   *dist = nv_sqrt(d2);
   *dir = vec3_scale(to, 1.0f / *dist);
-  if (l->type == LIGHT_RECTANGLE) {
+  if (LIGHT_IS_RECT(l)) {
     const float cos_l = -vec3_dot(*dir, vec3_from4(l->normal));
     if (!(cos_l > 0.0f)) return 0;
     I = vec3_scale(I, l->normal.w * cos_l);

@@ -35,18 +35,30 @@ static inline float phase_hg_sample_cos(float g, float u) {
   return nv_fmin(1.0f, nv_fmax(-1.0f, mu));
 }
 
+/* Scene specialisation (DESIGN.md "model only what a scene needs"; host/render/kernel_features.h):
+ * -DPHASE_FIXED_ISOTROPIC or -DPHASE_FIXED_HG fixes the phase function at build time, so the
+ * compiler folds the test on `kind` (the host sets one only when the scene's medium has that phase
+ * function: the arithmetic is the generic kernel's, bit for bit). Neither: the runtime `kind`. */
+#if defined(PHASE_FIXED_ISOTROPIC)
+#define PHASE_IS_HG(kind) 0
+#elif defined(PHASE_FIXED_HG)
+#define PHASE_IS_HG(kind) 1
+#else
+#define PHASE_IS_HG(kind) ((kind) == 1)
+#endif
+
 /* Phase function selected by `kind` (PHASE_ISOTROPIC or PHASE_HG from structs.h). */
 static inline float phase_eval(int kind, float g, vec3 w_in, vec3 w_out) {
-  return kind == 1 ? phase_hg_eval(g, vec3_dot(w_in, w_out)) : NV_INV_4PI;
+  return PHASE_IS_HG(kind) ? phase_hg_eval(g, vec3_dot(w_in, w_out)) : NV_INV_4PI;
 }
 
 /* Samples w_out given the propagation direction w_in; returns it and writes its pdf. */
 static inline vec3 phase_sample(int kind, float g, vec3 w_in, float u1, float u2, NV_PRIVATE float* pdf) {
-  const float mu = kind == 1 ? phase_hg_sample_cos(g, u1) : 1.0f - 2.0f * u1;
+  const float mu = PHASE_IS_HG(kind) ? phase_hg_sample_cos(g, u1) : 1.0f - 2.0f * u1;
   const vec3 w_out = sample_direction_around(w_in, mu, u2);
   /* The pdf of the direction actually returned: for |g| near 1 the HG peak is a few float steps
    * of μ wide, and MIS needs the same value phase_pdf gives for this direction. */
-  *pdf = kind == 1 ? phase_hg_eval(g, vec3_dot(w_in, w_out)) : NV_INV_4PI;
+  *pdf = PHASE_IS_HG(kind) ? phase_hg_eval(g, vec3_dot(w_in, w_out)) : NV_INV_4PI;
   return w_out;
 }
 

@@ -88,6 +88,18 @@
    (m)->majorant_grid.cells_z > 0)
 #endif
 
+/* Grey or chromatic σ (scene specialisation, host/render/kernel_features.h): -DMEDIUM_GREY keeps only
+ * the analogue walk in tracking_delta, -DMEDIUM_CHROMATIC only spectral tracking; the host sets one
+ * exactly when medium_params.grey says so, so the walk taken is the generic kernel's, bit for bit.
+ * Neither: the runtime flag. */
+#if defined(MEDIUM_GREY)
+#define TRACKING_GREY(m) 1
+#elif defined(MEDIUM_CHROMATIC)
+#define TRACKING_GREY(m) 0
+#else
+#define TRACKING_GREY(m) ((m)->grey)
+#endif
+
 /* Counters (-DCOUNTERS): per work-item counts of tentative (delta/spectral tracking) and real
  * (absorbing or scattering) collisions and of density lookups (both walks), in private 64-bit
  * integers; the kernel adds them to per-pixel slots of its own (pathtrace.cl), the host sums those:
@@ -179,7 +191,7 @@ static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM,
   }
   if (!(m->majorant > 0.0f)) return TRACK_ESCAPED;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
-  const int grey = m->grey;
+  const int grey = TRACKING_GREY(m);
   tracking_walk w = tracking_walk_begin(m, TRACKING_USE_MAJORANT_GRID(m), o, d, t, t_max);
   for (int step = 0; step < TRACKING_MAX_STEPS; ++step) {
     if (!tracking_walk_step(&w, GRID_MAJORANTS, sample_exponential(rng_uniform(rng), 1.0f), status))
