@@ -21,6 +21,30 @@ namespace narval::test {
 
 // ---------------------------------------------------------------- Listing 4.1
 
+// A box of Henyey–Greenstein cloud (g 0.7, density 4, rotated 15° about y) lit by a rectangle
+// behind it and a coloured point light in front, over a blue background: every light kind, MIS,
+// the box transform and escaping rays in one small scene. `renderer` is the "renderer" object;
+// scattering/absorption are JSON triples (unequal channels make the medium chromatic).
+inline std::string litCloudJson(const std::string& renderer, const std::string& scattering = "[1.0, 1.1, 1.2]",
+                                const std::string& absorption = "[0.02, 0.02, 0.02]") {
+  return R"({
+  "materials": [
+    {"name": "light", "type": "emitter", "albedo": [8, 8, 8]},
+    {"name": "bulb", "type": "emitter", "albedo": [3, 2, 1]},
+    {"name": "cloud", "type": "volume", "scattering": )" + scattering + R"(, "absorption": )" + absorption + R"(,
+     "phaseFunction": "hg", "g": 0.7, "density": 4}
+  ],
+  "primitives": [
+    {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 6], "scale": [8, 6, 1]}, "materialName": "light"},
+    {"name": "point", "type": "point", "transform": {"position": [-2, 2, -1]}, "materialName": "bulb"},
+    {"name": "box", "type": "volume", "transform": {"scale": [3, 3, 3], "rotation": [0, 15, 0]}, "materialName": "cloud"}
+  ],
+  "camera": {"position": [0, 0, -7], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 35},
+  "renderer": )" + renderer + R"(,
+  "background": [0.1, 0.1, 0.2]
+})";
+}
+
 // Dissertation Listing 4.1, character for character as printed (the "renderer" block's odd
 // indentation and trailing spaces included), with the volume path replaceable.
 inline std::string listing41Json(const std::string& volumePath = "vdb/wdas_cloud_quarter.vdb") {

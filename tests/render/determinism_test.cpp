@@ -4,27 +4,13 @@
 #include <gtest/gtest.h>
 
 #include "render_fixture.h"
+#include "test_support.h"
 #include "volume/grid.h"
 
 namespace narval::test {
 namespace {
 
-const char* kCloudScene = R"({
-  "materials": [
-    {"name": "light", "type": "emitter", "albedo": [8, 8, 8]},
-    {"name": "bulb", "type": "emitter", "albedo": [3, 2, 1]},
-    {"name": "cloud", "type": "volume", "scattering": [1.0, 1.1, 1.2], "absorption": [0.02, 0.02, 0.02],
-     "phaseFunction": "hg", "g": 0.7, "density": 4}
-  ],
-  "primitives": [
-    {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 6], "scale": [8, 6, 1]}, "materialName": "light"},
-    {"name": "point", "type": "point", "transform": {"position": [-2, 2, -1]}, "materialName": "bulb"},
-    {"name": "box", "type": "volume", "transform": {"scale": [3, 3, 3], "rotation": [0, 15, 0]}, "materialName": "cloud"}
-  ],
-  "camera": {"position": [0, 0, -7], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 35},
-  "renderer": {"resolution": [37, 23], "spp": 8, "bounces": 6, "seed": 11},
-  "background": [0.1, 0.1, 0.2]
-})";
+const std::string kCloudScene = litCloudJson(R"({"resolution": [37, 23], "spp": 8, "bounces": 6, "seed": 11})");
 
 TEST(RenderDeterminism, BitwiseIdenticalAcrossRunsAndLocalSizes) {
   const DenseGrid cloud = makeCloud(24, 3);

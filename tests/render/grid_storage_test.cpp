@@ -43,22 +43,8 @@ constexpr double kRelTolerance = 1e-4;
 constexpr double kScaleTolerance = 1e-5;
 
 std::string cloudScene(const std::string& algorithm) {
-  return R"({
-  "materials": [
-    {"name": "light", "type": "emitter", "albedo": [8, 8, 8]},
-    {"name": "bulb", "type": "emitter", "albedo": [3, 2, 1]},
-    {"name": "cloud", "type": "volume", "scattering": [1.0, 1.1, 1.2], "absorption": [0.02, 0.02, 0.02],
-     "phaseFunction": "hg", "g": 0.7, "density": 4}
-  ],
-  "primitives": [
-    {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 6], "scale": [8, 6, 1]}, "materialName": "light"},
-    {"name": "point", "type": "point", "transform": {"position": [-2, 2, -1]}, "materialName": "bulb"},
-    {"name": "box", "type": "volume", "transform": {"scale": [3, 3, 3], "rotation": [0, 15, 0]}, "materialName": "cloud"}
-  ],
-  "camera": {"position": [0, 0, -7], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 35},
-  "renderer": {"resolution": [40, 30], "spp": 16, "bounces": 6, "seed": 5, "algorithm": ")" + algorithm + R"("},
-  "background": [0.1, 0.1, 0.2]
-})";
+  return litCloudJson(R"({"resolution": [40, 30], "spp": 16, "bounces": 6, "seed": 5, "algorithm": ")" + algorithm +
+                      R"("})");
 }
 
 // The scene rendered in each storage; both runs clean.

@@ -94,22 +94,8 @@ TEST(MajorantRender, WhiteFurnaceOnDisneyCloudIsExactlyOneWithTheMajorantGrid) {
 // measured from the D_i themselves, so the bound stays exact. Control: the global render with the
 // density multiplier 10% higher differs by |z| > 4 in every channel, so the test sees a change of
 // that size. The same check is done for the image mean's level: both within 5% of each other.
-const char* kLitCloud = R"({
-  "materials": [
-    {"name": "light", "type": "emitter", "albedo": [8, 8, 8]},
-    {"name": "bulb", "type": "emitter", "albedo": [3, 2, 1]},
-    {"name": "cloud", "type": "volume", "scattering": [1.0, 1.3, 1.6], "absorption": [0.05, 0.02, 0.02],
-     "phaseFunction": "hg", "g": 0.7, "density": 4}
-  ],
-  "primitives": [
-    {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 6], "scale": [8, 6, 1]}, "materialName": "light"},
-    {"name": "point", "type": "point", "transform": {"position": [-2, 2, -1]}, "materialName": "bulb"},
-    {"name": "box", "type": "volume", "transform": {"scale": [3, 3, 3], "rotation": [0, 15, 0]}, "materialName": "cloud"}
-  ],
-  "camera": {"position": [0, 0, -7], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 35},
-  "renderer": {"resolution": [32, 24], "spp": 32, "bounces": 6, "seed": 5},
-  "background": [0.1, 0.1, 0.2]
-})";
+const std::string kLitCloud = litCloudJson(R"({"resolution": [32, 24], "spp": 32, "bounces": 6, "seed": 5})",
+                                           "[1.0, 1.3, 1.6]", "[0.05, 0.02, 0.02]");
 
 // z of the mean per-pixel difference a − b, channel c.
 double differenceZ(const ImageRGB& a, const ImageRGB& b, int c) {

@@ -9,6 +9,7 @@
 #include "../../bench/native/native_render.h"
 #include "render/lobe_directions.h"
 #include "render/realtime_renderer.h"
+#include "test_support.h"
 #include "render/render_fixture.h"  // absorptionBoxJson and its analytic transmittance (no device used)
 #include "volume/grid.h"
 
@@ -17,22 +18,8 @@ namespace {
 
 // A lit chromatic cloud (spectral tracking, a rectangle and a point light, background): every code
 // path the path tracer and the marches have, on a generated grid.
-const char* kLitCloud = R"({
-  "materials": [
-    {"name": "light", "type": "emitter", "albedo": [8, 8, 8]},
-    {"name": "bulb", "type": "emitter", "albedo": [3, 2, 1]},
-    {"name": "cloud", "type": "volume", "scattering": [1.0, 1.3, 1.6], "absorption": [0.05, 0.02, 0.02],
-     "phaseFunction": "hg", "g": 0.7, "density": 4}
-  ],
-  "primitives": [
-    {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 6], "scale": [8, 6, 1]}, "materialName": "light"},
-    {"name": "point", "type": "point", "transform": {"position": [-2, 2, -1]}, "materialName": "bulb"},
-    {"name": "box", "type": "volume", "transform": {"scale": [3, 3, 3], "rotation": [0, 15, 0]}, "materialName": "cloud"}
-  ],
-  "camera": {"position": [0, 0, -7], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 35},
-  "renderer": {"resolution": [24, 17], "spp": 8, "bounces": 6, "seed": 5},
-  "background": [0.1, 0.1, 0.2]
-})";
+const std::string kLitCloud = litCloudJson(R"({"resolution": [24, 17], "spp": 8, "bounces": 6, "seed": 5})",
+                                           "[1.0, 1.3, 1.6]", "[0.05, 0.02, 0.02]");
 
 native::NativeOptions optionsFor(const Scene& scene, const DeviceScene& ds, const std::string& algorithm) {
   native::NativeOptions o;
