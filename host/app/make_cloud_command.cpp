@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 
@@ -20,8 +21,14 @@ Command addMakeCloudCommand(CLI::App& app) {
   sub->add_option("--seed", a->seed, "Shape seed");
   return {sub, [a]() {
             const auto t0 = std::chrono::steady_clock::now();
-            DenseGrid grid = makeCloud(a->resolution, a->seed);
-            writeVdb(a->out, grid, "density", 1.0f / float(a->resolution));
+            // Slab by slab (about 256 MiB each, whole leaf nodes): the dense cloud is never held
+            // (a 1024^3 one would be 4 GiB, 2048^3 32 GiB). Same file as writeVdb(makeCloud(...)).
+            const int r = a->resolution;
+            const size_t slice = size_t(r) * size_t(r) * sizeof(float);
+            const int slab = std::max(8, int((size_t(256) << 20) / slice) / 8 * 8);
+            writeVdbSlabs(
+                a->out, r, r, r, slab, [&](int z0, int z1, float* out) { makeCloudSlab(r, a->seed, z0, z1, out); },
+                "density", 1.0f / float(r));
             const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             std::cout << "wrote " << a->out << " (" << a->resolution << "^3, seed " << a->seed << ", " << s
                       << " s)\n";

@@ -50,6 +50,8 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
   return {{"algorithm", s.algorithm},
           {"device", s.device},
           {"storage", s.storage},
+          {"grid_bytes", s.gridBytes},
+          {"bricks", {{"total", s.bricks}, {"occupied", s.bricksOccupied}}},
           {"width", s.width},
           {"height", s.height},
           {"spp", s.spp},
@@ -227,8 +229,9 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("--stats-json", a->statsJson, "Write render statistics as JSON");
   sub->add_option("--storage", a->storage,
                   "Density grid on the device: image (3D image, hardware sampler), buffer (float buffer, the "
-                  "shared trilinear filter) or auto (buffer on CPUs, image on GPUs); renderer.storage")
-      ->check(CLI::IsMember({"auto", "image", "buffer"}));
+                  "shared trilinear filter), bricks (sparse 8^3 bricks: grids beyond one image or buffer) or auto "
+                  "(buffer on CPUs, image on GPUs; bricks when those cannot hold the grid); renderer.storage")
+      ->check(CLI::IsMember({"auto", "image", "buffer", "bricks"}));
   sub->add_option("--local-size", a->localSize, "Work-group shape WxH (default 8x8); never changes the pixels");
   sub->add_option("--samples-per-pass", a->samplesPerPass,
                   "pathtrace: samples per pixel per launch (default: about 2^20 paths per launch); never "

@@ -40,6 +40,7 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   result.warnings = dev.scene.warnings;
   result.stats = initialStats("pathtrace", rt, scene);
   RenderStats& st = result.stats;
+  recordGridStorage(st, dev);
   st.majorant = resolveMajorant(options.majorant, rt.selected.info);
   st.counters = options.counters;
   applyMajorantResolution(rt, dev,

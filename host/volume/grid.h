@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -55,6 +56,14 @@ std::vector<std::string> vdbGridNames(const std::string& path);
 void writeVdb(const std::string& path, const DenseGrid& grid, const std::string& gridName = "density",
               float voxelSize = 1.0f);
 
+// The same file as writeVdb, for a grid produced a slab of z slices at a time (one that need not
+// fit in memory densely): fill(z0, z1, out) writes the nx·ny·(z1 - z0) values of slices [z0, z1),
+// x fastest, to `out`. Holds one slab of `slabSlices` slices (a positive multiple of 8: whole
+// OpenVDB leaf nodes) and the sparse tree. Throws as writeVdb.
+void writeVdbSlabs(const std::string& path, int nx, int ny, int nz, int slabSlices,
+                   const std::function<void(int, int, float*)>& fill, const std::string& gridName = "density",
+                   float voxelSize = 1.0f);
+
 // Test support (lives in vdb_io.cpp so tests need not include OpenVDB): writes a small .vdb that
 // exercises one loader path. kind: "vec3" (Vec3SGrid "velocity" + FloatGrid "heat"), "frustum"
 // (FloatGrid "density" under a frustum map), "huge" (two active voxels 2047 apart: a 2048^3 box,
@@ -75,7 +84,12 @@ void checkDensityValues(DenseGrid& grid, const std::string& key, const std::stri
 constexpr float kCloudMargin = 0.08f;
 
 // Procedural cumulus-like cloud: noise-displaced blobs with soft edges, density in [0, 1],
-// resolution^3 voxels, deterministic for (resolution, seed).
+// resolution^3 voxels, deterministic for (resolution, seed). Throws std::invalid_argument for a
+// resolution under 8 or over kMaxDenseGridBytes.
 DenseGrid makeCloud(int resolution, uint32_t seed);
+// Slices [z0, z1) of makeCloud(resolution, seed), the same bits, into `out`
+// (resolution²·(z1 - z0) floats, x fastest): for clouds too large to hold densely (make-cloud
+// writes them slab by slab with writeVdbSlabs).
+void makeCloudSlab(int resolution, uint32_t seed, int z0, int z1, float* out);
 
 }  // namespace narval

@@ -11,8 +11,8 @@
 //      [kFit, 1 - kFit]^3 of the unit cube, centred; voxel centres (i + 0.5) / resolution are
 //      evaluated there, so the shape does not depend on the resolution. Voxels whose centre lies
 //      within kCloudMargin of a face are exactly 0 (the fit keeps the cloud clear of them anyway).
-// Only integer hashing and float arithmetic in a fixed order: the same bits on every run and for
-// any thread count (each voxel is computed independently of the others).
+// Only integer hashing and float arithmetic in a fixed order: the same bits on every run, for any
+// thread count and any split into slabs of z slices (each voxel is computed independently).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -171,14 +171,9 @@ inline float smin(float a, float b, float k) {
 
 }  // namespace
 
-DenseGrid makeCloud(int resolution, uint32_t seed) {
+void makeCloudSlab(int resolution, uint32_t seed, int z0, int z1, float* out) {
   if (resolution < 8) throw std::invalid_argument("makeCloud: resolution must be at least 8");
-  const uint64_t bytes = uint64_t(resolution) * uint64_t(resolution) * uint64_t(resolution) * sizeof(float);
-  if (bytes > kMaxDenseGridBytes) {
-    throw std::invalid_argument("makeCloud: resolution " + std::to_string(resolution) + " needs " +
-                                std::to_string(bytes >> 20) + " MiB of floats, over the " +
-                                std::to_string(kMaxDenseGridBytes >> 20) + " MiB limit of a dense grid");
-  }
+  if (z0 < 0 || z1 < z0 || z1 > resolution) throw std::invalid_argument("makeCloudSlab: slices out of range");
   const std::vector<Blob> blobs = placeBlobs(seed);
   const uint32_t noiseSeed = hash32(seed ^ 0xa136aaadu);
 
@@ -200,17 +195,13 @@ DenseGrid makeCloud(int resolution, uint32_t seed) {
   float qOff[3];
   for (int a = 0; a < 3; ++a) qOff[a] = 0.5f * (lo[a] + hi[a]) - 0.5f * invScale;
 
-  DenseGrid grid;
-  grid.nx = grid.ny = grid.nz = resolution;
-  grid.source = "procedural cloud (seed " + std::to_string(seed) + ")";
-  grid.data.assign(size_t(resolution) * size_t(resolution) * size_t(resolution), 0.0f);
-
+  std::fill(out, out + size_t(resolution) * size_t(resolution) * size_t(z1 - z0), 0.0f);
   const float invRes = 1.0f / float(resolution);
   std::vector<float> coord(static_cast<size_t>(resolution));  // normalised voxel centres
   for (int i = 0; i < resolution; ++i) coord[size_t(i)] = (float(i) + 0.5f) * invRes;
   const float lowEdge = kCloudMargin, highEdge = 1.0f - kCloudMargin;
 
-  tbb::parallel_for(tbb::blocked_range<int>(0, resolution), [&](const tbb::blocked_range<int>& range) {
+  tbb::parallel_for(tbb::blocked_range<int>(z0, z1), [&](const tbb::blocked_range<int>& range) {
     for (int k = range.begin(); k != range.end(); ++k) {
       const float pz = coord[size_t(k)];
       if (pz < lowEdge || pz > highEdge) continue;
@@ -221,7 +212,7 @@ DenseGrid makeCloud(int resolution, uint32_t seed) {
         const float qy = py * invScale + qOff[1];
         if (qy <= 0.0f) continue;  // below the base
         const float base = smoothstep(0.0f, kBaseFade, qy);
-        float* row = grid.data.data() + size_t(resolution) * (size_t(j) + size_t(resolution) * size_t(k));
+        float* row = out + size_t(resolution) * (size_t(j) + size_t(resolution) * size_t(k - z0));
         for (int i = 0; i < resolution; ++i) {
           const float px = coord[size_t(i)];
           if (px < lowEdge || px > highEdge) continue;
@@ -242,7 +233,21 @@ DenseGrid makeCloud(int resolution, uint32_t seed) {
       }
     }
   });
+}
 
+DenseGrid makeCloud(int resolution, uint32_t seed) {
+  if (resolution < 8) throw std::invalid_argument("makeCloud: resolution must be at least 8");
+  const uint64_t bytes = uint64_t(resolution) * uint64_t(resolution) * uint64_t(resolution) * sizeof(float);
+  if (bytes > kMaxDenseGridBytes) {
+    throw std::invalid_argument("makeCloud: resolution " + std::to_string(resolution) + " needs " +
+                                std::to_string(bytes >> 20) + " MiB of floats, over the " +
+                                std::to_string(kMaxDenseGridBytes >> 20) + " MiB limit of a dense grid");
+  }
+  DenseGrid grid;
+  grid.nx = grid.ny = grid.nz = resolution;
+  grid.source = "procedural cloud (seed " + std::to_string(seed) + ")";
+  grid.data.resize(size_t(resolution) * size_t(resolution) * size_t(resolution));
+  makeCloudSlab(resolution, seed, 0, resolution, grid.data.data());
   grid.maxValue = *std::max_element(grid.data.begin(), grid.data.end());
   return grid;
 }

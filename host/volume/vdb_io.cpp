@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -474,6 +475,45 @@ DenseGrid loadVdb(const std::string& path, const std::string& gridName) {
   return out;
 }
 
+namespace {
+
+// The grid's metadata, then the file (atomically).
+void finishAndWrite(const std::string& path, openvdb::FloatGrid::Ptr vdb, const std::string& gridName, float voxelSize) {
+  vdb->setName(gridName);
+  vdb->setGridClass(openvdb::GRID_FOG_VOLUME);
+  vdb->setTransform(openvdb::math::Transform::createLinearTransform(double(voxelSize)));
+  vdb->insertMeta("creator", openvdb::StringMetadata("narval"));
+  writeGrids(path, {vdb});
+}
+
+}  // namespace
+
+void writeVdbSlabs(const std::string& path, int nx, int ny, int nz, int slabSlices,
+                   const std::function<void(int, int, float*)>& fill, const std::string& gridName, float voxelSize) {
+  initOpenVdb();
+  if (nx < 1 || ny < 1 || nz < 1 || slabSlices < 8 || slabSlices % 8 != 0)
+    throw std::invalid_argument("writeVdbSlabs: bad dimensions or slab depth (a positive multiple of 8)");
+  if (!(voxelSize > 0.0f) || !std::isfinite(voxelSize)) {
+    throw std::invalid_argument("writeVdb: voxel size must be positive and finite");
+  }
+  openvdb::FloatGrid::Ptr vdb = openvdb::FloatGrid::create(0.0f);
+  const size_t slice = size_t(nx) * size_t(ny);
+  std::vector<float> slab(slice * size_t(std::min(slabSlices, nz)));
+  // Slabs start at multiples of 8 slices: every leaf node (8³ voxels from index 0) lies in one
+  // slab, so copyFromDense builds each leaf whole, as it does from the whole grid.
+  for (int z0 = 0; z0 < nz; z0 += slabSlices) {
+    const int z1 = std::min(nz, z0 + slabSlices);
+    fill(z0, z1, slab.data());
+    const size_t n = slice * size_t(z1 - z0);
+    const size_t nans = size_t(std::count_if(slab.begin(), slab.begin() + long(n), [](float v) { return std::isnan(v); }));
+    if (nans > 0) throw std::invalid_argument("writeVdb: the grid holds " + std::to_string(nans) + " NaN values");
+    const openvdb::CoordBBox bbox(openvdb::Coord(0, 0, z0), openvdb::Coord(nx - 1, ny - 1, z1 - 1));
+    const openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, slab.data());
+    openvdb::tools::copyFromDense(dense, *vdb, /*tolerance=*/0.0f, /*serial=*/false);
+  }
+  finishAndWrite(path, vdb, gridName, voxelSize);
+}
+
 void writeVdb(const std::string& path, const DenseGrid& grid, const std::string& gridName, float voxelSize) {
   initOpenVdb();
   if (grid.nx < 0 || grid.ny < 0 || grid.nz < 0 || grid.data.size() != grid.voxelCount()) {
@@ -494,11 +534,7 @@ void writeVdb(const std::string& path, const DenseGrid& grid, const std::string&
     const openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, const_cast<float*>(grid.data.data()));
     openvdb::tools::copyFromDense(dense, *vdb, /*tolerance=*/0.0f, /*serial=*/false);
   }
-  vdb->setName(gridName);
-  vdb->setGridClass(openvdb::GRID_FOG_VOLUME);
-  vdb->setTransform(openvdb::math::Transform::createLinearTransform(double(voxelSize)));
-  vdb->insertMeta("creator", openvdb::StringMetadata("narval"));
-  writeGrids(path, {vdb});
+  finishAndWrite(path, vdb, gridName, voxelSize);
 }
 
 void writeVdbTestFile(const std::string& path, const std::string& kind) {

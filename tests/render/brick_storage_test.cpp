@@ -137,20 +137,20 @@ TEST(BrickStorage, RaymarchRendersTheBuffersPixels) { expectBricksRenderTheBuffe
 TEST(BrickStorage, LobeRendersTheBuffersPixels) { expectBricksRenderTheBuffersPixels("lobe"); }
 
 // The render path of the fall-back: a device whose largest allocation holds the cloud's bricks but
-// not its buffer. Auto picks bricks, warns with the occupancy and size, reports them in the stats
+// neither its buffer nor its image. Auto picks bricks, warns with the occupancy and size, reports them in the stats
 // and renders the buffer storage's pixels.
 TEST(BrickStorage, AutoRendersFromBricksOnADeviceTooSmallForTheBuffer) {
   const DenseGrid cloud = makeCloud(40, 7);
   const BrickLayout layout = planBricks(cloud);
   ASSERT_LT(layout.bufferBytes(), gridBufferBytes(cloud));
   ClRuntime small = runtime();
-  small.selected.info.maxAllocBytes = layout.bufferBytes();
-  small.selected.info.type = "CPU";
+  small.selected.info.maxAllocBytes = layout.bufferBytes();  // under the dense bytes: no image, no buffer
+  ASSERT_LT(layout.bufferBytes(), cloud.voxelCount() * sizeof(float));
   for (const char* algorithm : {"raymarch", "pathtrace"}) {
     SCOPED_TRACE(algorithm);
     Scene scene = sceneFromJson(cloudScene(algorithm));
     scene.renderer.spp = 2;
-    RenderOptions o;
+    const RenderOptions o;  // the same options for both renders: the same majorant choices
     const RenderResult r = std::string(algorithm) == "pathtrace" ? renderPathtrace(small, scene, &cloud, o)
                                                                   : renderRealtime(small, scene, &cloud, 1, o);
     ASSERT_EQ(r.warnings.size(), 1u);
@@ -162,7 +162,7 @@ TEST(BrickStorage, AutoRendersFromBricksOnADeviceTooSmallForTheBuffer) {
         << r.warnings[0];
     EXPECT_NE(r.warnings[0].find(byteCount(layout.bufferBytes())), std::string::npos) << r.warnings[0];
     scene.renderer.storage = GridStorage::Buffer;
-    const RenderResult b = std::string(algorithm) == "pathtrace" ? render(scene, &cloud)
+    const RenderResult b = std::string(algorithm) == "pathtrace" ? renderPathtrace(runtime(), scene, &cloud, o)
                                                                   : renderRealtime(runtime(), scene, &cloud, 1, o);
     EXPECT_EQ(r.image.rgb, b.image.rgb);
     if (std::string(algorithm) == "raymarch") {  // the path tracer's stats: see pathtrace_renderer.cpp
