@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.h"
+#include "image/image.h"
 
 namespace narval::test {
 namespace {
@@ -47,6 +48,24 @@ TEST_F(StorageCli, AnUnknownStorageIsAUsageError) {
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "narval: --storage: texture not in {auto,image,buffer,bricks} (see narval --help)\n");
   EXPECT_FALSE(std::filesystem::exists(dir_ / "s.exr"));
+}
+
+// Sparse bricks (issue 6, item 6) give the buffer storage's pixels bit for bit (the same corner
+// values through the same filter arithmetic, kernels/shared/grid.h), for the path tracer and the
+// ray marcher alike, and --stats-json names the storage.
+TEST_F(StorageCli, BricksRenderTheBuffersPixels) {
+  for (const char* algorithm : {"pathtrace", "raymarch"}) {
+    for (const char* storage : {"buffer", "bricks"}) {
+      const RunResult r = run(std::string("render s.json -o ") + storage + ".exr --algorithm " + algorithm +
+                              " --stats-json " + storage + ".json --storage " + storage);
+      ASSERT_EQ(r.code, 0) << r.err;
+      EXPECT_EQ(r.err.find("narval: warning"), std::string::npos) << r.err;
+      EXPECT_EQ(nlohmann::json::parse(readFile(dir_ / (std::string(storage) + ".json")))["storage"], storage);
+    }
+    const ImageRGB bricks = readExr((dir_ / "bricks.exr").string()), buffer = readExr((dir_ / "buffer.exr").string());
+    EXPECT_EQ(bricks.rgb, buffer.rgb) << algorithm;
+    EXPECT_FALSE(bricks.rgb.empty());
+  }
 }
 
 }  // namespace
