@@ -31,9 +31,8 @@ while [ $# -gt 0 ]; do
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
-if [ "$narval" = build/narval ] && [ ! -x build/narval ]; then scripts/setup.sh >/dev/null; fi
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. bench/bench_common.sh
+bench_init
 
 run() {  # algorithm storage -> seconds (pathtrace: kernel seconds; others: median kernel s per frame)
   local alg=$1 storage=$2 extra
@@ -41,15 +40,11 @@ run() {  # algorithm storage -> seconds (pathtrace: kernel seconds; others: medi
   # shellcheck disable=SC2086
   "$narval" render "$scene" -o "$work/$alg-$storage.exr" --algorithm "$alg" --resolution "$resolution" $extra \
     $device --set "renderer.storage=$storage" --stats-json "$work/s.json" >/dev/null
-  python3 - "$work/s.json" "$alg" <<'PY'
-import json, sys
-s = json.load(open(sys.argv[1]))
-print(s["kernel_seconds"] if sys.argv[2] == "pathtrace" else s["ms_per_frame"]["median"] / 1e3)
-PY
+  bench_seconds "$work/s.json" "$alg"
 }
 
 run "${algorithms%% *}" buffer >/dev/null  # also warms up the first algorithm's buffer program
-echo "device: $(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['device'])" "$work/s.json")"
+echo "device: $(bench_device "$work/s.json")"
 echo "scene: $scene at $resolution (pathtrace: $spp spp; real-time: median of $frames frames); $reps alternating repetitions"
 echo
 echo "| algorithm | image s (median) | buffer s (median) | image/buffer | per-repetition image/buffer |"

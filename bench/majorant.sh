@@ -37,9 +37,8 @@ while [ $# -gt 0 ]; do
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
-if [ "$narval" = build/narval ] && [ ! -x build/narval ]; then scripts/setup.sh >/dev/null; fi
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. bench/bench_common.sh
+bench_init
 
 # config name -> CLI options
 opts() {

@@ -33,9 +33,8 @@ while [ $# -gt 0 ]; do
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
-if [ "$narval" = build/narval ] && [ ! -x build/narval ]; then scripts/setup.sh >/dev/null; fi
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. bench/bench_common.sh
+bench_init
 
 run() {  # scene algorithm generic(0|1) -> seconds
   local scene=$1 alg=$2 generic=$3 extra
@@ -43,16 +42,12 @@ run() {  # scene algorithm generic(0|1) -> seconds
   # shellcheck disable=SC2086
   NARVAL_GENERIC=$generic "$narval" render "$scene" -o "$work/out.exr" --algorithm "$alg" \
     --resolution "$resolution" $extra $device --stats-json "$work/s.json" >/dev/null
-  python3 - "$work/s.json" "$alg" <<'PY'
-import json, sys
-s = json.load(open(sys.argv[1]))
-print(s["kernel_seconds"] if sys.argv[2] == "pathtrace" else s["ms_per_frame"]["median"] / 1e3)
-PY
+  bench_seconds "$work/s.json" "$alg"
 }
 
 first=${scenes%% *}
 run "$first" "${algorithms%% *}" 0 >/dev/null
-echo "device: $(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['device'])" "$work/s.json")"
+echo "device: $(bench_device "$work/s.json")"
 echo "load average at start: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
 echo "$resolution; pathtrace: $spp spp, kernel seconds; real-time: median kernel s per frame of $frames frames;" \
   "$reps alternating repetitions after a warm-up of each program"
