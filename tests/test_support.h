@@ -17,7 +17,25 @@
 #include <utility>
 #include <vector>
 
+#include "scene/input_error.h"
+
 namespace narval::test {
+
+// The message of the InputError `fn` throws ("" and a test failure if it throws anything else or
+// nothing).
+template <typename Fn>
+std::string inputErrorOf(Fn&& fn) {
+  try {
+    fn();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected InputError, nothing was thrown";
+  return "";
+}
 
 // ---------------------------------------------------------------- Listing 4.1
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "scene/input_error.h"
+#include "test_support.h"
 #include "scene/scene.h"
 #include "volume/grid.h"
 
@@ -27,23 +28,10 @@ using narval::InputError;
 
 namespace {
 
-// The message of the InputError `fn` throws ("" and a test failure otherwise).
-template <typename Fn>
-std::string errorOf(Fn&& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected InputError, nothing was thrown";
-  return "";
-}
+using narval::test::inputErrorOf;
 
 std::string sceneError(const std::string& json, const std::vector<std::string>& overrides = {}) {
-  return errorOf([&] { narval::parseScene(json, "s.json", overrides); });
+  return inputErrorOf([&] { narval::parseScene(json, "s.json", overrides); });
 }
 
 DenseGrid parseVolText(const std::string& text, size_t chunkBytes = size_t(1) << 20) {
@@ -52,7 +40,7 @@ DenseGrid parseVolText(const std::string& text, size_t chunkBytes = size_t(1) <<
 }
 
 std::string volError(const std::string& text, size_t chunkBytes = size_t(1) << 20) {
-  return errorOf([&] { parseVolText(text, chunkBytes); });
+  return inputErrorOf([&] { parseVolText(text, chunkBytes); });
 }
 
 // A scene that loads but for the materials given (its volume primitive uses "fog").
@@ -159,7 +147,7 @@ TEST(FuzzRegressionVol, SizeComesFromTheStream) {
   EXPECT_EQ(narval::parseVol(in, "f.vol").data, (std::vector<float>{0.5f, 1.0f}));
   std::istringstream small("ignored\n2 1 1\n0.5\n");
   small.seekg(8);
-  EXPECT_EQ(errorOf([&] { narval::parseVol(small, "f.vol"); }), "f.vol: declares 2x1x1 = 2 values, found 1");
+  EXPECT_EQ(inputErrorOf([&] { narval::parseVol(small, "f.vol"); }), "f.vol: declares 2x1x1 = 2 values, found 1");
   // A stream without a size cannot be checked against its header before allocating.
   struct ForwardOnly : std::stringbuf {
     using std::stringbuf::stringbuf;
@@ -167,7 +155,7 @@ TEST(FuzzRegressionVol, SizeComesFromTheStream) {
     pos_type seekpos(pos_type, std::ios_base::openmode) override { return pos_type(off_type(-1)); }
   } buf("1 1 1\n1\n");
   std::istream forward(&buf);
-  EXPECT_EQ(errorOf([&] { narval::parseVol(forward, "f.vol"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::parseVol(forward, "f.vol"); }),
             "f.vol: cannot read the file: cannot determine its size");
 }
 

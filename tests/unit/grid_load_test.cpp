@@ -35,20 +35,7 @@ namespace {
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// The message of the InputError `fn` throws ("" and a test failure if it throws nothing).
-template <typename Fn>
-std::string errorOf(Fn&& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected InputError, nothing was thrown";
-  return "";
-}
+using narval::test::inputErrorOf;
 
 // ---- real data ----
 
@@ -103,9 +90,9 @@ TEST(VdbRealData, SmokeEncodingsHoldTheSameGrid) {
 TEST(VdbRealData, FireWithoutDensityNamesTheGridsItHas) {
   const std::string path = realDataPath("embergen_fire_a_50.vdb");
   NARVAL_REQUIRE_REAL_DATA(path);
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(path, "density"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(path, "density"); }),
             path + ": grid: no grid named 'density' (the file has: flames, temperature)");
-  EXPECT_EQ(errorOf([&] { narval::loadGrid(path); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadGrid(path); }),
             path + ": grid: no grid named 'density' (the file has: flames, temperature)");
   EXPECT_EQ(narval::vdbGridNames(path), (std::vector<std::string>{"flames", "temperature"}));
   // Half-float grids load as float grids.
@@ -145,14 +132,14 @@ TEST(VdbRealData, TruncatedOrCorruptFilesAreCleanErrors) {
   const std::string cut = dir.file("cut.vdb");
   for (double fraction : {0.0, 0.001, 0.01, 0.1, 0.3, 0.5, 0.9, 0.999}) {
     writeFile(cut, bytes.substr(0, size_t(double(bytes.size()) * fraction)));
-    const std::string msg = errorOf([&] { narval::loadVdb(cut, "density"); });
+    const std::string msg = inputErrorOf([&] { narval::loadVdb(cut, "density"); });
     EXPECT_EQ(msg.rfind(cut + ": ", 0), 0u) << "fraction " << fraction << ": " << msg;
   }
   // Garbage after a valid header region.
   std::string corrupt = bytes;
   for (size_t i = 4096; i < corrupt.size(); i += 7) corrupt[i] = char(corrupt[i] ^ 0x5a);
   writeFile(cut, corrupt);
-  const std::string msg = errorOf([&] { narval::loadVdb(cut, "density"); });
+  const std::string msg = inputErrorOf([&] { narval::loadVdb(cut, "density"); });
   EXPECT_EQ(msg.rfind(cut + ": ", 0), 0u) << msg;
 }
 
@@ -235,7 +222,7 @@ TEST(VdbRoundTrip, OverwritesAnExistingFileAndKeepsTheGridName) {
   narval::writeVdb(path, paddedGrid(4, 4, 4, 0, 0, 0), "smoke", 1.0f);
   narval::writeVdb(path, paddedGrid(5, 4, 4, 0, 0, 0), "smoke", 1.0f);
   EXPECT_EQ(narval::loadVdb(path, "smoke").nx, 5);
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(path, "density"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(path, "density"); }),
             path + ": grid: no grid named 'density' (the file has: smoke)");
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.vdb"});
 }
@@ -243,7 +230,7 @@ TEST(VdbRoundTrip, OverwritesAnExistingFileAndKeepsTheGridName) {
 TEST(VdbErrors, UnwritablePathIsAnInputError) {
   TempDir dir;
   const std::string path = dir.file("no/such/dir/out.vdb");
-  const std::string msg = errorOf([&] { narval::writeVdb(path, paddedGrid(2, 2, 2, 0, 0, 0)); });
+  const std::string msg = inputErrorOf([&] { narval::writeVdb(path, paddedGrid(2, 2, 2, 0, 0, 0)); });
   EXPECT_EQ(msg.rfind(path + ": cannot write the file (", 0), 0u) << msg;
 }
 
@@ -256,13 +243,13 @@ TEST(VdbErrors, NonFiniteAndNegativeValuesAreCountedAndRejected) {
   g.data[20] = -kInf;  // (0, 2, 1)
   g.data[22] = -0.5f;  // (2, 2, 1)
   narval::writeVdb(path, g);
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(path, "density"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(path, "density"); }),
             path + ": grid: 'density' has 2 non-finite and 2 negative values (first at voxel 3 1 0); "
                    "densities must be finite and >= 0");
   // NaN (which copyFromDense would silently turn into inactive background) comes from a file
   // written directly: active voxels (0,0,0) = 1, (1,0,0) = NaN, (2,0,0) = -1, (3,0,0) = +inf.
   narval::writeVdbTestFile(path, "invalid");
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(path, "density"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(path, "density"); }),
             path + ": grid: 'density' has 2 non-finite and 1 negative values (first at voxel 1 0 0); "
                    "densities must be finite and >= 0");
   // writeVdb refuses NaN rather than dropping it.
@@ -273,18 +260,18 @@ TEST(VdbErrors, NonFiniteAndNegativeValuesAreCountedAndRejected) {
 TEST(VdbErrors, MissingAndNonVdbFiles) {
   TempDir dir;
   const std::string missing = dir.file("missing.vdb");
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(missing, "density"); }), missing + ": cannot open the file: no such file");
-  EXPECT_EQ(errorOf([&] { narval::vdbGridNames(missing); }), missing + ": cannot open the file: no such file");
-  EXPECT_EQ(errorOf([&] { narval::loadGrid(missing); }), missing + ": cannot open the file: no such file");
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(dir.file(""), "density"); }).find("it is a directory") != std::string::npos,
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(missing, "density"); }), missing + ": cannot open the file: no such file");
+  EXPECT_EQ(inputErrorOf([&] { narval::vdbGridNames(missing); }), missing + ": cannot open the file: no such file");
+  EXPECT_EQ(inputErrorOf([&] { narval::loadGrid(missing); }), missing + ": cannot open the file: no such file");
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(dir.file(""), "density"); }).find("it is a directory") != std::string::npos,
             true);
   const std::string text = dir.file("text.vdb");
   writeFile(text, "this is not a vdb file at all, just some text\n");
-  const std::string msg = errorOf([&] { narval::loadVdb(text, "density"); });
+  const std::string msg = inputErrorOf([&] { narval::loadVdb(text, "density"); });
   EXPECT_EQ(msg.rfind(text + ": not a readable OpenVDB file (", 0), 0u) << msg;
   const std::string empty = dir.file("empty.vdb");
   writeFile(empty, "");
-  const std::string msg2 = errorOf([&] { narval::loadVdb(empty, "density"); });
+  const std::string msg2 = inputErrorOf([&] { narval::loadVdb(empty, "density"); });
   EXPECT_EQ(msg2.rfind(empty + ": not a readable OpenVDB file (", 0), 0u) << msg2;
 }
 
@@ -292,9 +279,9 @@ TEST(VdbErrors, NonFloatGridsAreNamedAsSuch) {
   TempDir dir;
   const std::string path = dir.file("vec3.vdb");
   narval::writeVdbTestFile(path, "vec3");
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(path, "velocity"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(path, "velocity"); }),
             path + ": grid: 'velocity' is a vec3s grid; narval needs a float grid (float grids in the file: heat)");
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(path, "density"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(path, "density"); }),
             path + ": grid: no grid named 'density' (the file has: heat, velocity (vec3s))");
   EXPECT_EQ(narval::vdbGridNames(path), std::vector<std::string>{"heat"});
   EXPECT_EQ(narval::loadVdb(path, "heat").maxValue, 1.0f);
@@ -304,17 +291,17 @@ TEST(VdbErrors, FrustumEmptyAndOversizedGrids) {
   TempDir dir;
   const std::string frustum = dir.file("frustum.vdb");
   narval::writeVdbTestFile(frustum, "frustum");
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(frustum, "density"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(frustum, "density"); }),
             frustum + ": grid: 'density' has a non-affine index-to-world transform (NonlinearFrustumMap); "
                       "narval supports affine transforms only");
   const std::string empty = dir.file("empty.vdb");
   narval::writeVdbTestFile(empty, "empty");
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(empty, "density"); }), empty + ": grid: 'density' has no active voxels");
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(empty, "density"); }), empty + ": grid: 'density' has no active voxels");
   const std::string huge = dir.file("huge.vdb");
   narval::writeVdbTestFile(huge, "huge");
   // The size is refused from the bounding box, before any dense allocation (that is what the
   // message reports: the box, not a failed allocation).
-  EXPECT_EQ(errorOf([&] { narval::loadVdb(huge, "density"); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(huge, "density"); }),
             huge + ": grid: 'density' active bounding box 2048x2048x2048 = 8589934592 voxels needs 32768 MiB as "
                    "dense floats, over the 8192 MiB limit");
 }
@@ -407,7 +394,7 @@ TEST(VolFormat, HeaderErrors) {
   const std::string p = dir.file("bad.vol");
   auto err = [&](const std::string& text) {
     writeFile(p, text);
-    return errorOf([&] { narval::loadVol(p); });
+    return inputErrorOf([&] { narval::loadVol(p); });
   };
   const std::string hdr = p + ": line 1: expected the header 'X Y Z' (three positive integers), found ";
   EXPECT_EQ(err(""), hdr + "an empty file");
@@ -426,7 +413,7 @@ TEST(VolFormat, AbsurdSizesFailBeforeAllocating) {
   const std::string p = dir.file("big.vol");
   auto err = [&](const std::string& text) {
     writeFile(p, text);
-    return errorOf([&] { narval::loadVol(p); });
+    return inputErrorOf([&] { narval::loadVol(p); });
   };
   EXPECT_EQ(err("100000 100000 100000\n1 2 3\n"),
             p + ": line 1: header declares 100000x100000x100000 = 1000000000000000 values, over the limit of "
@@ -444,7 +431,7 @@ TEST(VolFormat, ValueErrors) {
   const std::string p = dir.file("v.vol");
   auto err = [&](const std::string& text) {
     writeFile(p, text);
-    return errorOf([&] { narval::loadVol(p); });
+    return inputErrorOf([&] { narval::loadVol(p); });
   };
   auto values = [](int n, const std::string& sep = " ") {
     std::string s;
@@ -477,14 +464,14 @@ TEST(GridLoad, DispatchOnExtension) {
   TempDir dir;
   const std::string raw = dir.file("cloud.raw");
   writeFile(raw, "1 1 1\n1\n");
-  EXPECT_EQ(errorOf([&] { narval::loadGrid(raw); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadGrid(raw); }),
             raw + ": unknown volume file type '.raw' (narval reads .vdb and .vol)");
   const std::string none = dir.file("cloud");
   writeFile(none, "1 1 1\n1\n");
-  EXPECT_EQ(errorOf([&] { narval::loadGrid(none); }),
+  EXPECT_EQ(inputErrorOf([&] { narval::loadGrid(none); }),
             none + ": unknown volume file type '(none)' (narval reads .vdb and .vol)");
   const std::string missing = dir.file("missing.vol");
-  EXPECT_EQ(errorOf([&] { narval::loadGrid(missing); }), missing + ": cannot open the file: no such file");
+  EXPECT_EQ(inputErrorOf([&] { narval::loadGrid(missing); }), missing + ": cannot open the file: no such file");
 }
 
 // ---- procedural cloud ----
