@@ -113,12 +113,7 @@ int run(const Args& a) {
   o.threads = a.threads;
   o.majorant = a.majorant == "auto" ? "grid" : a.majorant;
   o.spp = scene.renderer.spp;
-  o.realtime = realtimeParams(scene);
-  if (alg == "lobe") {
-    const scene_params& sp = ds.params;
-    const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
-    o.lobeDirections = lobeDirections(o.realtime.lobe_points, g, scene.renderer.seed);
-  }
+  native::prepareRealtimeInputs(scene, ds, o);
 
   std::vector<double> frameSeconds;
   native::NativeResult r;

@@ -52,6 +52,9 @@ static inline float native_fmaxf(float a, float b) { return (a > b || b != b) ? 
 #endif
 
 #include "image/image.h"
+#include "render/light_cache.h"
+#include "render/lobe_directions.h"
+#include "render/realtime_renderer.h"
 #include "render/render_common.h"
 #include "render/scene_upload.h"
 #include "shared/accum.h"
@@ -67,6 +70,8 @@ struct NativeOptions {
   std::string majorant = "grid";        // pathtrace: grid | global (as narval render --majorant)
   int spp = 1;                          // pathtrace samples per pixel
   realtime_params realtime{};           // raymarch / lobe (realtimeParams(scene))
+  std::vector<float> lightCache;        // raymarch / lobe with realtime.light_cache.nx > 0: the
+                                        // cache's slabs (buildLightCacheOnHost)
   std::vector<nv_float4> lobeDirections; // lobe: the canonical directions (lobeDirections(...))
 };
 
@@ -97,6 +102,22 @@ inline grid_view nativeGridView(const DeviceScene& ds, const NativeOptions& o) {
   return g;
 }
 
+// The real-time inputs the device driver (realtime_renderer.cpp) prepares: parameters, lobe
+// directions and the light cache's slabs, for o.algorithm (nothing for pathtrace).
+inline void prepareRealtimeInputs(const Scene& scene, const DeviceScene& ds, NativeOptions& o) {
+  if (o.algorithm == "pathtrace") return;
+  o.realtime = realtimeParams(scene, ds);
+  if (o.algorithm == "lobe") {
+    const scene_params& sp = ds.params;
+    const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
+    o.lobeDirections = lobeDirections(o.realtime.lobe_points, g, scene.renderer.seed);
+  }
+  if (o.realtime.light_cache.nx > 0) {
+    const grid_view gv = nativeGridView(ds, o);
+    o.lightCache = buildLightCacheOnHost(ds, &gv, o.realtime);
+  }
+}
+
 // Renders ds with the shared headers on host threads. Throws std::invalid_argument for an unknown
 // algorithm or majorant, or lobe without directions.
 inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) {
@@ -107,6 +128,8 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
     throw std::invalid_argument("renderNative: majorant must be grid or global, got '" + o.majorant + "'");
   if (alg == "lobe" && o.lobeDirections.empty())
     throw std::invalid_argument("renderNative: lobe needs its directions");
+  if (alg != "pathtrace" && o.realtime.light_cache.nx > 0 && o.lightCache.empty())
+    throw std::invalid_argument("renderNative: the light cache is on but was not built");
   const scene_params* sp = &ds.params;
   const light_params* lights = ds.lights.data();
   const int W = sp->camera.width, H = sp->camera.height;
@@ -115,6 +138,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
   const grid_view* grid = &gv;
   const realtime_params* rp = &o.realtime;
   const nv_float4* dirs = o.lobeDirections.data();
+  const float* cache = o.lightCache.data();
   const int kind = alg == "pathtrace" ? 0 : (alg == "raymarch" ? 1 : 2);
 
   // RGBA as the kernels write it: pathtrace the Kahan sums (A = 0), real-time the value.
@@ -138,9 +162,9 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
           }
           L = vec3_make(ax, ay, az);
         } else if (kind == 1) {
-          L = raymarch_pixel(sp, lights, grid, rp, x, y, &status);
+          L = raymarch_pixel(sp, lights, grid, rp, cache, x, y, &status);
         } else {
-          L = lobe_pixel(sp, lights, grid, rp, dirs, x, y, &status);
+          L = lobe_pixel(sp, lights, grid, rp, dirs, cache, x, y, &status);
         }
         row[size_t(x) * 4 + 0] = L.x;
         row[size_t(x) * 4 + 1] = L.y;

@@ -5,19 +5,23 @@
 
 #include "render/device_allocation.h"
 #include "render/device_scene.h"
+#include "render/light_cache.h"
 #include "render/lobe_directions.h"
 #include "render/majorant_options.h"
 #include "render/render_common.h"
 #include "scene/input_error.h"
+#include "volume/majorant_grid.h"
 
 namespace narval {
 
-realtime_params realtimeParams(const Scene& scene) {
+realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes) {
   const RendererSettings& r = scene.renderer;
   const bool lobe = r.algorithm == "lobe";
   realtime_params p{};
-  p.steps = r.raymarch.steps;
+  p.steps = lobe ? r.lobe.firstHitSteps : r.raymarch.steps;
   p.shadow_steps = lobe ? r.lobe.shadowSteps : r.raymarch.shadowSteps;
+  p.view_steps = r.lobe.viewSteps;
+  p.min_transmittance = lobe ? r.lobe.minTransmittance : r.raymarch.minTransmittance;
   p.octaves = r.raymarch.octaves;
   p.octave_a = r.raymarch.octaveScattering;
   p.octave_b = r.raymarch.octaveExtinction;
@@ -25,6 +29,7 @@ realtime_params realtimeParams(const Scene& scene) {
   p.depth_factor = r.lobe.depthFactor;
   p.lobe_radius = r.lobe.lobeRadius;
   p.lobe_points = r.lobe.lobePoints;
+  p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
   return p;
 }
 
@@ -44,10 +49,19 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   RenderStats& st = result.stats;
   recordGridStorage(st, dev);
   st.majorant = "grid";  // the marches always skip empty cells (march.h); options.majorant is the path tracer's
-  applyMajorantResolution(rt, dev, options.majorantResolution, st);
+  // The marches place their samples over the occupied cells of the majorant grid (march.h), so its
+  // resolution is part of their quadrature: they keep buildDeviceScene's, whatever the path
+  // tracer's --majorant-resolution says, and that flag changes no real-time pixel.
+  applyMajorantResolution(rt, dev, 0, st);
+  if (options.majorantResolution > 0)
+    result.warnings.push_back("--majorant-resolution applies to the path tracer; " + algorithm +
+                              " samples over the occupied cells of the default " +
+                              std::to_string(kDefaultMajorantResolution) + "-cell grid");
   st.spp = st.sppRequested = 1;
 
-  const realtime_params params = realtimeParams(scene);
+  const realtime_params params = realtimeParams(scene, dev.scene, rt.selected.info.maxAllocBytes);
+  DeviceLightCache lightCache;
+  cl::Buffer noCache;
   const scene_params& sp = dev.scene.params;
   const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
   std::vector<nv_float4> dirs = algorithm == "lobe" ? lobeDirections(params.lobe_points, g, scene.renderer.seed)
@@ -68,8 +82,12 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
   kernel.setArg(arg + 0, paramBuf);
   kernel.setArg(arg + 1, dirBuf);
-  kernel.setArg(arg + 2, outBuf);
-  kernel.setArg(arg + 3, statusBuf);
+  kernel.setArg(arg + 3, outBuf);
+  kernel.setArg(arg + 4, statusBuf);
+  if (params.light_cache.nx == 0) {
+    noCache = cl::Buffer(rt.context, CL_MEM_READ_ONLY, sizeof(float));  // never read
+    kernel.setArg(arg + 2, noCache);
+  }
   rt.queue.finish();
   st.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -80,6 +98,10 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   const int requested = std::max(1, frames);
   std::vector<double> kernelMs, wallMs;
   for (int f = 0; f < requested && !cancelled(options); ++f) {
+    if (params.light_cache.nx > 0) {  // a no-op unless the scene changed (never, within one render)
+      lightCache.update(rt, dev, params, scene.sourcePath);
+      kernel.setArg(arg + 2, lightCache.buffer());
+    }
     const auto tf = std::chrono::steady_clock::now();
     const cl::Event ev = launchAndWait(rt, kernel, global, local, algorithm, deviceBytes);
     wallMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tf).count());
@@ -95,6 +117,13 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   rt.queue.enqueueReadBuffer(outBuf, CL_TRUE, 0, rgba.size() * sizeof(float), rgba.data());
   rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &st.status);
   st.passes = int(kernelMs.size());
+  st.status |= lightCache.status();
+  st.lightCacheMs = lightCache.buildMs();
+  st.lightCacheBuilds = lightCache.slabsBuilt();
+  st.lightCacheBytes = lightCache.bytes();
+  st.lightCacheCells[0] = std::max(0, params.light_cache.nx - 1);
+  st.lightCacheCells[1] = std::max(0, params.light_cache.ny - 1);
+  st.lightCacheCells[2] = std::max(0, params.light_cache.nz - 1);
   st.frames = frameTimings(kernelMs, wallMs);
   for (double ms : kernelMs) st.kernelSeconds += ms * 1e-3;
   for (double ms : wallMs) st.seconds += ms * 1e-3;

@@ -84,6 +84,13 @@ struct RenderStats {
   // collisions, density lookups of delta and ratio tracking (kernels/shared/tracking.h).
   bool counters = false;
   uint64_t collisionsTentative = 0, collisionsReal = 0, densityLookups = 0;
+  // Real-time kernels: the light-transmittance cache (render/light_cache.h): cells per axis (0 0 0:
+  // off), device bytes, light slabs built in this run (one per light unless something changed
+  // between frames) and their build time, reported apart from the frame times.
+  int lightCacheCells[3] = {0, 0, 0};
+  size_t lightCacheBytes = 0;
+  int lightCacheBuilds = 0;
+  double lightCacheMs = 0;
 };
 
 struct RenderResult {

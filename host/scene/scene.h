@@ -78,6 +78,9 @@ struct RaymarchSettings {
   float octaveScattering = 0.5f;  // a
   float octaveExtinction = 0.5f;  // b
   float octavePhase = 0.5f;       // c
+  // Early termination of the view march: it stops once every channel's transmittance is below
+  // this (kernels/shared/raymarch.h derives the error bound); 0 marches to the end.
+  float minTransmittance = 1e-3f;
 };
 
 struct LobeSettings {
@@ -85,6 +88,15 @@ struct LobeSettings {
   int lobePoints = 30;
   float lobeRadius = 1.0f;
   int shadowSteps = 100;
+  int firstHitSteps = 60;        // samples of the first-hit search (then 6 bisections)
+  int viewSteps = 24;            // samples of each transmittance from the first hit to a lobe point
+  float minTransmittance = 1e-3f;  // those transmittances stop below it (lobe.h: error < it · L_b)
+};
+
+// The light-transmittance cache of the real-time kernels (kernels/shared/light_cache.h).
+constexpr int kLightCacheAuto = -1;
+struct LightCacheSettings {
+  int resolution = kLightCacheAuto;  // cells on the medium box's longest axis; 0 = off; auto: measured
 };
 
 struct RendererSettings {
@@ -99,6 +111,7 @@ struct RendererSettings {
   GridStorage storage = GridStorage::Auto;
   RaymarchSettings raymarch;
   LobeSettings lobe;
+  LightCacheSettings lightCache;
 };
 
 struct Scene {

@@ -54,10 +54,16 @@
 // |   raymarch.shadowSteps  | integer                         |     | 10          | >= 1                       |
 // |   raymarch.octaves      | integer                         |     | 1           | [1, 16]; 1 = off           |
 // |   raymarch.octaveScattering, .octaveExtinction, .octavePhase (a, b, c) | number | | 0.5 | [0, 1], a <= b   |
+// |   raymarch.minTransmittance | number: view march stops   |     | 0.001       | [0, 1); 0 = never          |
 // |   lobe.depthFactor      | number                          |     | 20          | >= 0                       |
 // |   lobe.lobePoints       | integer                         |     | 30          | >= 1                       |
 // |   lobe.lobeRadius       | number, world units             |     | 1           | >= 0                       |
 // |   lobe.shadowSteps      | integer                         |     | 100         | >= 1                       |
+// |   lobe.firstHitSteps    | integer                         |     | 60          | >= 1                       |
+// |   lobe.viewSteps        | integer: Tr(x0 -> P_i) samples  |     | 24          | >= 1                       |
+// |   lobe.minTransmittance | number: Tr(x0 -> P_i) stops     |     | 0.001       | [0, 1); 0 = never          |
+// |   lightCache.resolution | "auto" or integer: cells on the |     | auto        | [0, 1024]; 0 = off (exact  |
+// |                         | box's longest axis              |     |             | shadow marches)            |
 // | background              | vec3: radiance of escaping rays |     | [0, 0, 0]   | >= 0                       |
 //
 // Unknown keys (anywhere, including keys of the other material type) are warnings, never errors,
@@ -168,6 +174,14 @@ float readNonNegative(ObjectReader& r, const std::string& name, float fallback) 
 float readUnitInterval(ObjectReader& r, const std::string& name, float fallback) {
   const float v = r.getFloat(name, fallback);
   if (!(v >= 0 && v <= 1)) r.context().fail(r.keyOf(name), "must be in [0, 1], got " + formatNumber(v));
+  return v;
+}
+
+// A transmittance below which a march stops: [0, 1) (0 = never stops; 1 would stop at once).
+float readMinTransmittance(ObjectReader& r, float fallback) {
+  const float v = r.getFloat("minTransmittance", fallback);
+  if (!(v >= 0 && v < 1))
+    r.context().fail(r.keyOf("minTransmittance"), "must be in [0, 1) (0 = never stop), got " + formatNumber(v));
   return v;
 }
 
@@ -317,6 +331,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
       ctx.fail(m.keyOf("octaveScattering"), "must not exceed octaveExtinction (" +
                                                 formatNumber(s.raymarch.octaveExtinction) +
                                                 ") or the octaves add energy");
+    s.raymarch.minTransmittance = readMinTransmittance(m, s.raymarch.minTransmittance);
     m.reportUnknown();
   }
   if (const json* v = r.find("lobe")) {
@@ -325,7 +340,24 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
     s.lobe.lobePoints = readInt(l, "lobePoints", s.lobe.lobePoints, 1);
     s.lobe.lobeRadius = readNonNegative(l, "lobeRadius", s.lobe.lobeRadius);
     s.lobe.shadowSteps = readInt(l, "shadowSteps", s.lobe.shadowSteps, 1);
+    s.lobe.firstHitSteps = readInt(l, "firstHitSteps", s.lobe.firstHitSteps, 1);
+    s.lobe.viewSteps = readInt(l, "viewSteps", s.lobe.viewSteps, 1);
+    s.lobe.minTransmittance = readMinTransmittance(l, s.lobe.minTransmittance);
     l.reportUnknown();
+  }
+  if (const json* v = r.find("lightCache")) {
+    ObjectReader c(ctx, *v, r.keyOf("lightCache"));
+    if (const json* res = c.find("resolution")) {
+      if (res->is_string() && res->get<std::string>() == "auto")
+        s.lightCache.resolution = kLightCacheAuto;
+      else if (res->is_number())
+        s.lightCache.resolution = static_cast<int>(
+            checkIntRange(ctx, c.keyOf("resolution"), toInteger(ctx, *res, c.keyOf("resolution")), 0, 1024));
+      else
+        ctx.fail(c.keyOf("resolution"), "expected \"auto\" or a number of cells (0 = off), got " +
+                                            (res->is_string() ? "\"" + res->get<std::string>() + "\"" : std::string(res->type_name())));
+    }
+    c.reportUnknown();
   }
   r.reportUnknown();
   return s;

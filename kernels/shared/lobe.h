@@ -4,13 +4,16 @@
  *   L = L_b · (1/n) Σ_i Tr(x0 → P_i)
  *     + albedo ⊙ Σ_k (1/n) Σ_i p(cos θ_i) · Tr(P_i → light_k) · I_k / |light_k − P_i|²
  *
- * Parameters (realtime_params, structs.h; scene keys renderer.lobe / renderer.raymarch):
- *   steps         samples of the first-hit search over the view ray's segment in the box
- *                 (renderer.raymarch.steps, default 60), then LOBE_BISECTIONS bisection steps
- *   shadow_steps  midpoint samples of every transmittance integral (renderer.lobe.shadowSteps, 100)
- *   depth_factor  lobe centre depth in mean free paths of unit density (default 20)
- *   lobe_radius   |P_i − c| in world units (default 1)
- *   lobe_points   n, the directions in `dirs` (default 30)
+ * Parameters (realtime_params, structs.h; scene keys renderer.lobe.*):
+ *   steps             samples of the first-hit search over the view ray's segment in the box
+ *                     (firstHitSteps, default 60), then LOBE_BISECTIONS bisection steps
+ *   shadow_steps      midpoint samples of each transmittance to a light (shadowSteps, default 100):
+ *                     the exact march, or the quadrature the light cache's nodes were built with
+ *   view_steps        midpoint samples of each Tr(x0 → P_i) (viewSteps)
+ *   min_transmittance Tr(x0 → P_i) stops once below it in every channel (minTransmittance)
+ *   depth_factor      lobe centre depth in mean free paths of unit density (default 20)
+ *   lobe_radius       |P_i − c| in world units (default 1)
+ *   lobe_points       n, the directions in `dirs` (default 30)
  *
  * 1. x0: the first point of the view ray inside the box where the density is above zero. The
  *    search takes `steps` midpoint samples over the occupied majorant cells only (march_iter) and
@@ -34,17 +37,22 @@
  *    ω), not vec3_basis(ω): the lobe is then attached to the camera, so moving camera and scene
  *    rigidly together leaves the image unchanged, and the frame varies smoothly across the image
  *    (vec3_basis flips where ω.z changes sign, which would print a seam).
- * 4. Transmittances by march_transmittance (midpoint rule, true step lengths, all channels, only
- *    the part inside the box), lights as points (march_light_as_point: a rectangle is a point at its
+ * 4. Transmittances by the midpoint rule (true step lengths, all channels, only the part inside
+ *    the box): Tr(x0 → P_i) over view_steps samples, Tr(P_i → light) by light_cache_optical_depth
+ *    (one lookup in the light-transmittance cache, or the exact march of shadow_steps), lights as points (march_light_as_point: a rectangle is a point at its
  *    centre with intensity Le·A·max(0, cos θ_light), as DESIGN.md allows for real-time kernels).
  *    Shadow rays see only the medium, not other rectangles. cos θ_i = dot(normalize(P_i − light),
  *    −d_i): light propagating from the light to P_i, then from P_i towards c. albedo = σs/σt per
  *    channel (0 where σt = 0).
+ * Economies that change no pixel: when L_b is exactly 0 the view transmittances are not marched
+ * (their term is 0·Tr = 0 either way). Early termination of Tr(x0 → P_i) (min_transmittance ε > 0):
+ * the march stops once every channel's partial τ exceeds −ln ε, so the value used is in
+ * [Tr_true, ε) and each of the n terms is off by less than ε: |ΔL| < ε·L_b per channel.
  * No medium, a ray that misses the box (or meets a rectangle light first), or no density > 0 on the
  * segment: L = L_b exactly (march_background). Means divide by n (not multiply by 1/n), so n
  * transmittances of exactly 1 give exactly L_b.
- * Loops: the first-hit search (`steps` samples, then LOBE_BISECTIONS), n lobe points × (1 + lights)
- * transmittance marches of shadow_steps samples: all bounded by the scene's parameters; the only
+ * Loops: the first-hit search (`steps` samples, then LOBE_BISECTIONS), n lobe points × (one march of
+ * view_steps + lights × (one cache lookup or a march of shadow_steps)): all bounded by the scene's parameters; the only
  * open-ended walk is the DDA under each march, capped by its budget (majorant.h).
  * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density, phase value or
  * lobe point met on the way; STATUS_ITERATION_CAP from a DDA walk. No pdf: never
@@ -52,11 +60,12 @@
 #ifndef NARVAL_LOBE_H
 #define NARVAL_LOBE_H
 
-#include "shared/march.h"
+#include "shared/light_cache.h"
 #include "shared/phase.h"
 
 /* Halvings of the first-hit step: x0 is placed within Δ/64 past the density's zero crossing. */
 #define LOBE_BISECTIONS 6
+
 
 /* The pinhole primary ray through image point (px, py) (pixel units, (0,0) the top-left corner):
  * camera.h's mapping without the thin lens (DESIGN.md: the real-time kernels are pinhole). */
@@ -102,16 +111,18 @@ static inline int lobe_first_hit(NV_CONSTANT const medium_params* m, GRID_PARAM,
   return 0;
 }
 
-/* Transmittance along the straight segment a → b (1 when they coincide). */
+/* Transmittance along the straight segment a → b (1 when they coincide), its march stopped once
+ * its optical depth exceeds tau_limit in every channel (NV_INFINITY: never). */
 static inline vec3 lobe_transmittance_between(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 a, vec3 b,
-                                              int steps, NV_PRIVATE uint* status) {
+                                              int steps, float tau_limit, NV_PRIVATE uint* status) {
   const vec3 ab = vec3_sub(b, a);
   const float dist = vec3_length(ab);
   if (!(dist > 0.0f)) {
     if (dist != dist) *status |= STATUS_NAN; /* a NaN point, not a coincident one */
     return vec3_splat(1.0f);
   }
-  return march_transmittance(m, GRID_ARG, a, vec3_scale(ab, 1.0f / dist), dist, steps, status);
+  return vec3_exp_neg(march_optical_depth_limited(m, GRID_ARG, a, vec3_scale(ab, 1.0f / dist), dist, steps, tau_limit,
+                                                  status));
 }
 
 /* Radiance of the view ray from `origin` along unit `dir`. `right` is the camera's unit right
@@ -119,7 +130,8 @@ static inline vec3 lobe_transmittance_between(NV_CONSTANT const medium_params* m
  * directions about +Z. */
 static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                  GRID_PARAM, NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
-                                 vec3 origin, vec3 dir, vec3 right, NV_PRIVATE uint* status) {
+                                 NV_GLOBAL const float* light_cache, vec3 origin, vec3 dir, vec3 right,
+                                 NV_PRIVATE uint* status) {
   /* L_b, and the view ray stops at the first rectangle it meets (rectangles are opaque). */
   const vec3 Lb = march_background(s, lights, origin, dir);
   if (!s->has_medium || p->lobe_points < 1) return Lb;
@@ -151,12 +163,15 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
 
   /* 4. Sums over the lobe points. */
   const int n = p->lobe_points;
+  const int view_term = !vec3_is_zero(Lb);
+  const float tau_limit = p->min_transmittance > 0.0f ? -nv_log(p->min_transmittance) : NV_INFINITY;
   vec3 tr_sum = vec3_splat(0.0f), in_sum = vec3_splat(0.0f);
   for (int i = 0; i < n; ++i) {
     const nv_float4 q = dirs[i];
     const vec3 d = vec3_add(vec3_add(vec3_scale(tx, q.x), vec3_scale(ty, q.y)), vec3_scale(dir, q.z));
     const vec3 P = vec3_madd(c, d, p->lobe_radius);
-    tr_sum = vec3_add(tr_sum, lobe_transmittance_between(m, GRID_ARG, x0, P, p->shadow_steps, status));
+    if (view_term)
+      tr_sum = vec3_add(tr_sum, lobe_transmittance_between(m, GRID_ARG, x0, P, p->view_steps, tau_limit, status));
     const vec3 w_out = vec3_scale(d, -1.0f); /* from P_i towards c */
     for (int k = 0; k < s->num_lights; ++k) {
       vec3 to_light, I;
@@ -168,7 +183,7 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
         if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
         continue;
       }
-      const vec3 tr = march_transmittance(m, GRID_ARG, P, to_light, dist, p->shadow_steps, status);
+      const vec3 tr = vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, k, P, to_light, dist, status));
       in_sum = vec3_add(in_sum, vec3_scale(vec3_mul(tr, I), f / (dist * dist)));
     }
   }
@@ -181,12 +196,13 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
 /* The pixel (px, py): ray through its centre (deterministic, no jitter). Non-finite results are
  * reported in *status and replaced by 0. */
 static inline vec3 lobe_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights, GRID_PARAM,
-                              NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs, int px, int py,
-                              NV_PRIVATE uint* status) {
+                              NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
+                              NV_GLOBAL const float* light_cache, int px, int py, NV_PRIVATE uint* status) {
   NV_CONSTANT const camera_params* cam = &s->camera;
   const vec3 dir = lobe_view_dir(cam, (float)px + 0.5f, (float)py + 0.5f);
   const vec3 L =
-      lobe_radiance(s, lights, GRID_ARG, p, dirs, vec3_from4(cam->position), dir, vec3_from4(cam->right), status);
+      lobe_radiance(s, lights, GRID_ARG, p, dirs, light_cache, vec3_from4(cam->position), dir, vec3_from4(cam->right),
+                    status);
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);

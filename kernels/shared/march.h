@@ -89,9 +89,13 @@ static inline int march_next(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRIVATE f
 /* Optical depth τ from `origin` over `dist` along unit `dir`: `steps` midpoint samples over the
  * occupied part of the segment inside the box, Σ σt·Δ. 0 outside the box. The ray marcher's
  * octaves need τ itself (exp(−bⁱτ)), which survives where exp(−τ) underflows. The walk's status
- * bits (march_iter.status) go to *status; a NaN density stays in τ for the caller's pixel check. */
-static inline vec3 march_optical_depth(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
-                                       float dist, int steps, NV_PRIVATE uint* status) {
+ * bits (march_iter.status) go to *status; a NaN density stays in τ for the caller's pixel check.
+ * The march stops early once every channel's partial τ exceeds tau_limit (NV_INFINITY: never, and
+ * then the sum is the full one, bit for bit): a view transmittance that is already below
+ * e^{−tau_limit} in every channel can only fall further, so what it returns is at most that and at
+ * least the true value (lobe.h derives what this costs a pixel). */
+static inline vec3 march_optical_depth_limited(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
+                                               float dist, int steps, float tau_limit, NV_PRIVATE uint* status) {
   medium_segment seg;
   if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) {
     /* A NaN ray misses every box: say so rather than pass it off as clear air. */
@@ -99,11 +103,20 @@ static inline vec3 march_optical_depth(NV_CONSTANT const medium_params* m, GRID_
     return vec3_splat(0.0f);
   }
   march_iter it = march_begin(m, GRID_ARG, &seg, steps);
+  const float sum_limit = tau_limit / it.delta; /* on Σσt, before the scaling by Δ */
   vec3 tau = vec3_splat(0.0f);
   float t;
-  while (march_next(&it, GRID_ARG, &t)) tau = vec3_add(tau, march_sigma_t(m, GRID_ARG, &seg, t));
+  while (march_next(&it, GRID_ARG, &t)) {
+    tau = vec3_add(tau, march_sigma_t(m, GRID_ARG, &seg, t));
+    if (nv_fmin(tau.x, nv_fmin(tau.y, tau.z)) > sum_limit) break;
+  }
   *status |= it.status;
   return vec3_scale(tau, it.delta);
+}
+
+static inline vec3 march_optical_depth(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
+                                       float dist, int steps, NV_PRIVATE uint* status) {
+  return march_optical_depth_limited(m, GRID_ARG, origin, dir, dist, steps, NV_INFINITY, status);
 }
 
 /* Transmittance exp(−τ) over the same quadrature (1 outside the box). */
@@ -112,15 +125,36 @@ static inline vec3 march_transmittance(NV_CONSTANT const medium_params* m, GRID_
   return vec3_exp_neg(march_optical_depth(m, GRID_ARG, origin, dir, dist, steps, status));
 }
 
+/* Column density ∫ρ ds over the same quadrature as march_optical_depth (Σ ρ·Δ): the medium's σt
+ * is σt_unit·ρ with one σt_unit per channel, so τ = σt_unit·column for every channel at once; the
+ * light-transmittance cache (light_cache.h) stores this one float per node. */
+static inline float march_column_density(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
+                                         float dist, int steps, NV_PRIVATE uint* status) {
+  medium_segment seg;
+  if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) {
+    if (!(vec3_is_finite(origin) && vec3_is_finite(dir) && dist == dist)) *status |= STATUS_NAN;
+    return 0.0f;
+  }
+  march_iter it = march_begin(m, GRID_ARG, &seg, steps);
+  float column = 0.0f, t;
+  while (march_next(&it, GRID_ARG, &t)) column += grid_density(GRID_ARG, vec3_madd(seg.o, seg.d, t));
+  *status |= it.status;
+  return column * it.delta;
+}
+
+/* Where the real-time kernels put a light: a point light's position, a rectangle's centre. */
+static inline vec3 march_light_position(NV_CONSTANT const light_params* l) {
+  const vec3 p = vec3_from4(l->corner);
+  if (LIGHT_IS_RECT(l)) return vec3_add(p, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
+  return p;
+}
+
 /* A light as seen from x, as a point: unit direction to it, distance, and the intensity I (W/sr)
  * towards x, so the irradiance-like factor is I / dist². Returns 0 when it sends nothing to x. */
 static inline int march_light_as_point(NV_CONSTANT const light_params* l, vec3 x, NV_PRIVATE vec3* dir,
                                        NV_PRIVATE float* dist, NV_PRIVATE vec3* intensity) {
-  vec3 p = vec3_from4(l->corner);
   vec3 I = vec3_from4(l->radiance);
-  if (LIGHT_IS_RECT(l))
-    p = vec3_add(p, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
-  const vec3 to = vec3_sub(p, x);
+  const vec3 to = vec3_sub(march_light_position(l), x);
   const float d2 = vec3_dot(to, to);
   if (!(d2 > 0.0f)) return 0;
   *dist = nv_sqrt(d2);

@@ -38,6 +38,19 @@
  * U the same march with the phase function and the shadow transmittance replaced by 1: bounded
  * whenever a < 1. (a ≤ b keeps each octave's effective albedo σs·aⁱ/(σt·bⁱ) ≤ σs/σt.)
  *
+ * Shadow rays: light_cache_optical_depth (light_cache.h): one lookup in the light-transmittance
+ * cache when it is on, else a march of shadow_steps samples.
+ *
+ * Early termination (min_transmittance = ε > 0; 0 never stops): the march stops after the step
+ * where every channel of T fell below ε, and the pixel is L + T·L_b with the T reached. Error bound,
+ * per channel: what the rest of the march would have added is Σ_{k'} T_{k'}·(S_{k'}/σt_{k'})·
+ * (1 − e^{−σt_{k'}Δ}) (the energy-conserving step) ≤ T·max_{k'}(S/σt)·(1 − T_rest) ≤ T·A, with
+ * A = sup of S/σt = albedo · Σ_lights (I/d²) · Σ_i aⁱ p(g cⁱ, μ) e^{−bⁱτ} over the rest of the
+ * segment, and the L_b term changes from T·T_rest·L_b to T·L_b, by at most T·L_b; the two have
+ * opposite signs, so |ΔL| ≤ T·max(A, L_b) < ε·max(A, L_b). A bound the host can evaluate: A ≤
+ * max albedo · Σ_lights I/d_min² · p_max · Σ_{i<N} aⁱ, d_min the light's distance from the box
+ * (tests/render/realtime_economy_test.cpp checks it).
+ *
  * Empty space: the `steps` samples are spread over the occupied majorant cells only (march_iter in
  * march.h), so empty parts of the box cost nothing and the step is shorter where there is medium.
  * Samples of zero density change nothing (S = 0, e^{−0} = 1) and skip the light loop.
@@ -49,7 +62,7 @@
 #define NARVAL_RAYMARCH_H
 
 #include "shared/camera.h"
-#include "shared/march.h"
+#include "shared/light_cache.h"
 #include "shared/phase.h"
 
 /* Below this optical depth per step, (1 − e^{−x})/x is evaluated by its Taylor series: the direct
@@ -69,7 +82,8 @@ static inline float raymarch_step_weight(float x, float e) {
 /* Light arriving at x and scattered towards the camera, per unit σs: Σ_lights (I/d²) ⊙
  * Σ_{i<N} aⁱ p(g cⁱ, μ) exp(−bⁱ τ). view_dir points away from the camera. */
 static inline vec3 raymarch_light_sum(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                      GRID_PARAM, NV_CONSTANT const realtime_params* rp, vec3 x, vec3 view_dir,
+                                      GRID_PARAM, NV_CONSTANT const realtime_params* rp,
+                                      NV_GLOBAL const float* light_cache, vec3 x, vec3 view_dir,
                                       NV_PRIVATE uint* status) {
   NV_CONSTANT const medium_params* m = &s->medium;
   vec3 sum = vec3_splat(0.0f);
@@ -77,7 +91,7 @@ static inline vec3 raymarch_light_sum(NV_CONSTANT const scene_params* s, NV_CONS
     vec3 dir, I;
     float dist;
     if (!march_light_as_point(&lights[l], x, &dir, &dist, &I)) continue;
-    const vec3 tau = march_optical_depth(m, GRID_ARG, x, dir, dist, rp->shadow_steps, status);
+    const vec3 tau = light_cache_optical_depth(m, GRID_ARG, rp, light_cache, l, x, dir, dist, status);
     /* Octave 0: plain single scattering. */
     vec3 oct = vec3_scale(vec3_exp_neg(tau), phase_eval(m->phase, m->g, view_dir, dir));
     if (rp->octaves > 1) {
@@ -107,7 +121,7 @@ typedef struct raymarch_accum {
  * the scene's own parameters, no cap of their own. */
 static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                     GRID_PARAM, NV_CONSTANT const realtime_params* rp,
-                                    NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, int steps,
+                                    NV_GLOBAL const float* light_cache, NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, int steps,
                                     NV_PRIVATE raymarch_accum* acc, NV_PRIVATE uint* status) {
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
@@ -124,21 +138,23 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
     const vec3 sigma_s = vec3_scale(ss, rho);
     vec3 S = vec3_splat(0.0f);
     if (!vec3_is_zero(sigma_s))
-      S = vec3_mul(sigma_s, raymarch_light_sum(s, lights, GRID_ARG, rp, vec3_madd(origin, dir, t), dir, status));
+      S = vec3_mul(sigma_s, raymarch_light_sum(s, lights, GRID_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir,
+                                               status));
     const vec3 x = vec3_scale(sigma_t, dt);
     const vec3 e = vec3_exp_neg(x);
     const vec3 w = vec3_make(raymarch_step_weight(x.x, e.x), raymarch_step_weight(x.y, e.y),
                              raymarch_step_weight(x.z, e.z));
     acc->L = vec3_add(acc->L, vec3_mul(acc->T, vec3_scale(vec3_mul(S, w), dt)));
     acc->T = vec3_mul(acc->T, e);
+    if (vec3_max_component(acc->T) < rp->min_transmittance) break; /* early termination (above) */
   }
   *status |= it.status;
 }
 
 /* Radiance through the centre of pixel (px, py). Pinhole: the ray leaves the lens centre. */
 static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                  GRID_PARAM, NV_CONSTANT const realtime_params* rp, int px, int py,
-                                  NV_PRIVATE uint* status) {
+                                  GRID_PARAM, NV_CONSTANT const realtime_params* rp,
+                                  NV_GLOBAL const float* light_cache, int px, int py, NV_PRIVATE uint* status) {
   const ray3 r = camera_ray(&s->camera, (float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f);
   const vec3 Lb = march_background(s, lights, r.origin, r.dir);
   vec3 L = Lb;
@@ -152,7 +168,7 @@ static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT
       raymarch_accum acc;
       acc.L = vec3_splat(0.0f);
       acc.T = vec3_splat(1.0f);
-      raymarch_segment(s, lights, GRID_ARG, rp, &seg, r.origin, r.dir, rp->steps, &acc, status);
+      raymarch_segment(s, lights, GRID_ARG, rp, light_cache, &seg, r.origin, r.dir, rp->steps, &acc, status);
       L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
     }
   }

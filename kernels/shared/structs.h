@@ -76,10 +76,21 @@ typedef struct medium_params {
   majorant_grid_params majorant_grid; /* density bounds per cell: empty space is skipped */
 } medium_params;
 
+/* The light-transmittance cache (kernels/shared/light_cache.h): per light, nx·ny·nz nodes spanning
+ * the medium's index box [0, dims] corner to corner, each holding the column density ∫ρ ds from the
+ * node to the light. nx = 0: no cache, the kernels march their shadow rays. */
+typedef struct light_cache_params {
+  nv_affine index_to_world; /* node points to world space (the inverse of medium.world_to_index) */
+  int nx;
+  int ny;
+  int nz;
+  int pad0;
+} light_cache_params;
+
 /* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
 typedef struct realtime_params {
-  int steps;            /* raymarch: samples over the view ray's segment inside the box */
-  int shadow_steps;     /* raymarch: samples per shadow ray; lobe: per transmittance integral */
+  int steps;            /* raymarch: samples over the view ray's segment; lobe: first-hit search samples */
+  int shadow_steps;     /* samples per shadow ray (and per light-cache node when the cache is built) */
   int octaves;          /* raymarch multiple-scattering octaves (Wrenninge et al. 2013); 1 = off */
   float octave_a;       /* scattering scale per octave */
   float octave_b;       /* extinction scale per octave (a <= b conserves energy) */
@@ -87,9 +98,10 @@ typedef struct realtime_params {
   float depth_factor;   /* lobe: centre at depth_factor mean free paths past the first hit */
   float lobe_radius;    /* lobe: world units */
   int lobe_points;      /* lobe: directions in the lobe_directions buffer */
+  int view_steps;       /* lobe: samples of each transmittance from the first hit to a lobe point */
+  float min_transmittance; /* view marches stop once every channel's transmittance is below it; 0: never */
   int pad0;
-  int pad1;
-  int pad2;
+  light_cache_params light_cache;
 } realtime_params;
 
 typedef struct scene_params {

@@ -34,8 +34,11 @@
   S(realtime_params) F(realtime_params, steps) F(realtime_params, shadow_steps)                   \
   F(realtime_params, octaves) F(realtime_params, octave_a) F(realtime_params, octave_b)           \
   F(realtime_params, octave_c) F(realtime_params, depth_factor) F(realtime_params, lobe_radius)   \
-  F(realtime_params, lobe_points) F(realtime_params, pad0) F(realtime_params, pad1)               \
-  F(realtime_params, pad2)
+  F(realtime_params, lobe_points) F(realtime_params, view_steps)                                  \
+  F(realtime_params, min_transmittance) F(realtime_params, pad0) F(realtime_params, light_cache)  \
+  F(realtime_params, light_cache.nz)                                                              \
+  S(light_cache_params) F(light_cache_params, index_to_world) F(light_cache_params, nx)           \
+  F(light_cache_params, ny) F(light_cache_params, nz) F(light_cache_params, pad0)
 
 #ifdef __OPENCL_C_VERSION__
 

@@ -108,7 +108,9 @@ TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
     ],
     "camera": {"position": [0.3, 0.2, -6], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 60},
     "renderer": {"resolution": [9, 7], "seed": 7,
-                 "lobe": {"depthFactor": 3, "lobePoints": 16, "lobeRadius": 0.8, "shadowSteps": 100}},
+                 "lightCache": {"resolution": 0},
+                 "lobe": {"depthFactor": 3, "lobePoints": 16, "lobeRadius": 0.8, "shadowSteps": 100,
+                          "viewSteps": 100, "minTransmittance": 0}},
     "background": [0.2, 0.3, 0.4]
   })");
   scene.renderer.algorithm = "lobe";
@@ -125,7 +127,7 @@ TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
   const double lightI[2][3] = {{10, 9, 8}, {4, 5, 6}};
   const std::vector<nv_float4> dirs = lobeDirections(16, float(g), 7);
 
-  const realtime_params params = realtimeParams(scene);
+  const realtime_params params = realtimeParams(scene, ds);
   const grid_view homogeneous{nullptr, 1, 1, 1};
   int hits = 0;
   for (int py = 0; py < 7; ++py)
@@ -164,7 +166,8 @@ TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
       // The very header the device ran, compiled for the host (DESIGN.md: shared headers are
       // tested on the host): same float algorithm, so agreement to float rounding.
       uint status = 0;
-      const vec3 host = lobe_pixel(&ds.params, ds.lights.data(), &homogeneous, &params, dirs.data(), px, py, &status);
+      const vec3 host =
+          lobe_pixel(&ds.params, ds.lights.data(), &homogeneous, &params, dirs.data(), nullptr, px, py, &status);
       EXPECT_EQ(status, 0u);
       const float hostRgb[3] = {host.x, host.y, host.z};
       for (int ch = 0; ch < 3; ++ch) {

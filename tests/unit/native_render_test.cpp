@@ -25,11 +25,7 @@ native::NativeOptions optionsFor(const Scene& scene, const DeviceScene& ds, cons
   native::NativeOptions o;
   o.algorithm = algorithm;
   o.spp = scene.renderer.spp;
-  o.realtime = realtimeParams(scene);
-  if (algorithm == "lobe") {
-    const float g = ds.params.medium.phase == PHASE_HG ? ds.params.medium.g : 0.0f;
-    o.lobeDirections = lobeDirections(o.realtime.lobe_points, g, scene.renderer.seed);
-  }
+  native::prepareRealtimeInputs(scene, ds, o);
   return o;
 }
 

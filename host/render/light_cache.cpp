@@ -1,0 +1,112 @@
+#include "render/light_cache.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "render/device_allocation.h"
+#include "render/render_common.h"
+#include "shared/light_cache.h"
+
+namespace narval {
+
+light_cache_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes) {
+  light_cache_params c{};
+  const scene_params& sp = ds.params;
+  if (resolution == 0 || !sp.has_medium) return c;
+  int cells = resolution == kLightCacheAuto ? kLightCacheAutoResolution : resolution;
+  const medium_params& m = sp.medium;
+  c.index_to_world = affineInverse(m.world_to_index);
+  // World length of each box edge: the index-to-world map's column times the box's index extent.
+  const float dims[3] = {m.dims.x, m.dims.y, m.dims.z};
+  float len[3];
+  for (int a = 0; a < 3; ++a) {
+    const float col[3] = {(&c.index_to_world.row[0].x)[a], (&c.index_to_world.row[1].x)[a],
+                          (&c.index_to_world.row[2].x)[a]};
+    len[a] = dims[a] * std::sqrt(col[0] * col[0] + col[1] * col[1] + col[2] * col[2]);
+  }
+  const float longest = std::max({len[0], len[1], len[2]});
+  int* nodes[3] = {&c.nx, &c.ny, &c.nz};
+  for (;;) {
+    for (int a = 0; a < 3; ++a)
+      *nodes[a] = 1 + std::max(1, int(std::lround(double(cells) * len[a] / longest)));
+    const size_t bytes = size_t(c.nx) * size_t(c.ny) * size_t(c.nz) * size_t(std::max(1, sp.num_lights)) * sizeof(float);
+    if (resolution != kLightCacheAuto || bytes <= maxAllocBytes || cells == 1) return c;
+    cells /= 2;
+  }
+}
+
+std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view* grid, const realtime_params& params) {
+  const light_cache_params& c = params.light_cache;
+  const int nodes = light_cache_nodes(&c);
+  std::vector<float> cache(size_t(nodes) * size_t(ds.params.num_lights));
+  uint32_t status = 0;
+  for (int l = 0; l < ds.params.num_lights; ++l)
+    for (int n = 0; n < nodes; ++n)
+      cache[size_t(l) * size_t(nodes) + size_t(n)] = light_cache_build_node(
+          &ds.params.medium, grid, &c, params.shadow_steps, &ds.lights[size_t(l)], n, &status);
+  return cache;
+}
+
+namespace {
+
+template <typename T>
+std::string bytesOf(const T& v) {
+  return std::string(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+}  // namespace
+
+void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params,
+                              const std::string& sceneFile) {
+  const light_cache_params& c = params.light_cache;
+  if (c.nx <= 0) throw std::invalid_argument("DeviceLightCache::update: the cache is off (nx = 0)");
+  const int numLights = dev.scene.params.num_lights;
+  const size_t nodes = size_t(c.nx) * size_t(c.ny) * size_t(c.nz);
+  // Everything a slab depends on besides its light. The grid is identified by its address: a
+  // DeviceSceneBuffers keeps its grid for its life, and a new scene makes a new one.
+  const std::string key = bytesOf(dev.scene.params.medium) + bytesOf(dev.scene.grid) + bytesOf(c) +
+                          bytesOf(params.shadow_steps) + dev.scene.buildOptions + bytesOf(numLights);
+  const bool all = key != mediumKey_;
+  if (all) {
+    bytes_ = std::max<size_t>(1, nodes * size_t(numLights)) * sizeof(float);
+    const AllocationSite site{sceneFile, "renderer.lightCache.resolution",
+                              "a light-transmittance cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
+                                  "x" + std::to_string(c.nz) + " nodes for " + std::to_string(numLights) + " lights"};
+    buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site);
+    program_ = buildProgram(rt, "light_cache.cl", dev.scene.buildOptions);
+    kernel_ = cl::Kernel(program_, "light_cache_build");
+    statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
+    lights_.assign(size_t(numLights), light_params{});
+  }
+  std::vector<int> stale;
+  for (int l = 0; l < numLights; ++l)
+    if (all || std::memcmp(&lights_[size_t(l)], &dev.scene.lights[size_t(l)], sizeof(light_params)) != 0)
+      stale.push_back(l);
+  if (stale.empty()) return;
+  const auto tLaunch = std::chrono::steady_clock::now();  // the program build above is not the cache's
+  paramBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(params),
+                         const_cast<realtime_params*>(&params));
+  rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
+  dev.bind(kernel_);
+  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
+  kernel_.setArg(arg + 0, paramBuf_);
+  kernel_.setArg(arg + 2, buffer_);
+  kernel_.setArg(arg + 3, statusBuf_);
+  const size_t local = 64, global = (nodes + local - 1) / local * local;
+  for (int l : stale) {
+    kernel_.setArg(arg + 1, cl_int(l));
+    launchAndWait(rt, kernel_, cl::NDRange(global), cl::NDRange(local), "the light-transmittance cache",
+                  deviceSceneBytes(dev.scene) + bytes_);
+    lights_[size_t(l)] = dev.scene.lights[size_t(l)];
+    ++slabsBuilt_;
+  }
+  cl_uint st = 0;
+  rt.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof st, &st);
+  status_ |= st;
+  mediumKey_ = key;
+  buildMs_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tLaunch).count();
+}
+
+}  // namespace narval

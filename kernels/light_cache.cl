@@ -1,0 +1,17 @@
+/* light_cache.cl: builds one light's slab of the light-transmittance cache (shared/light_cache.h).
+ * One work-item per node (1D, padded to a multiple of the local size; items past the slab return).
+ * `light` selects the light and its slab, so a light that changed is rebuilt alone. */
+#include "shared/light_cache.h"
+
+__kernel void light_cache_build(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
+                                __constant realtime_params* params, int light, __global float* cache,
+                                __global uint* status_word) {
+  const int node = get_global_id(0);
+  __constant light_cache_params* c = &params->light_cache;
+  const int nodes = light_cache_nodes(c);
+  if (node >= nodes) return;
+  uint status = 0u;
+  cache[(size_t)light * (size_t)nodes + (size_t)node] =
+      light_cache_build_node(&scene->medium, GRID_ARG, c, params->shadow_steps, &lights[light], node, &status);
+  if (status) atomic_or(status_word, status);
+}
