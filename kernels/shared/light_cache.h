@@ -93,12 +93,16 @@ static inline float light_cache_column_at(NV_CONSTANT const light_cache_params* 
 static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_CONSTANT const light_cache_params* c,
                                        NV_GLOBAL const float* cache, int light, vec3 x, vec3 dir, float dist,
                                        NV_PRIVATE uint* status) {
+  const vec3 dims = vec3_from4(m->dims);
+  const vec3 p = affine_point(m->world_to_index, x);
+  if (p.x >= 0.0f && p.y >= 0.0f && p.z >= 0.0f && p.x <= dims.x && p.y <= dims.y && p.z <= dims.z)
+    return light_cache_column_at(c, cache, light, dims, p); /* inside: no ray to clip */
   medium_segment seg;
   if (!medium_intersect(m, x, dir, 0.0f, dist, &seg)) {
     if (!(vec3_is_finite(x) && vec3_is_finite(dir) && dist == dist)) *status |= STATUS_NAN;
     return 0.0f;
   }
-  return light_cache_column_at(c, cache, light, vec3_from4(m->dims), vec3_madd(seg.o, seg.d, seg.t0));
+  return light_cache_column_at(c, cache, light, dims, vec3_madd(seg.o, seg.d, seg.t0));
 }
 
 /* Optical depth τ from x to light `light` (unit `dir`, `dist` from march_light_as_point), per

@@ -1,0 +1,98 @@
+// renderer.lightCache as a user drives it: --stats-json reports the cache (cells, bytes, slabs built,
+// build time apart from the frames), --frames K builds it once, a light moved with --set changes the
+// image and is built anew, and bad values are one line with exit 2 before any rendering.
+#include <nlohmann/json.hpp>
+
+#include "cli_fixture.h"
+#include "image/image.h"
+
+namespace narval::test {
+namespace {
+
+class LightCacheCli : public CliFixture {
+ protected:
+  void SetUp() override {
+    ASSERT_EQ(run("make-cloud c.vdb --resolution 24 --seed 4").code, 0);
+    // Two lights (a rectangle facing the cloud and a point light) over a cubic box.
+    write("s.json", R"({
+      "materials": [
+        {"name": "light", "type": "emitter", "albedo": [6, 6, 6]},
+        {"name": "bulb", "type": "emitter", "albedo": [3, 2, 1]},
+        {"name": "cloud", "type": "volume", "scattering": [1, 1, 1], "absorption": [0.05, 0.05, 0.05],
+         "phaseFunction": "hg", "g": 0.5, "density": 6, "path": "c.vdb"}
+      ],
+      "primitives": [
+        {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 4], "scale": [4, 4, 1]},
+         "materialName": "light"},
+        {"name": "point", "type": "point", "transform": {"position": [-2, 2, -1]}, "materialName": "bulb"},
+        {"name": "box", "type": "volume", "transform": {"scale": [2, 2, 2]}, "materialName": "cloud"}
+      ],
+      "camera": {"position": [0, 0, -6], "lookAt": [0, 0, 0], "vfov": 30},
+      "renderer": {"resolution": [24, 18], "algorithm": "raymarch"},
+      "background": [0.05, 0.05, 0.1]
+    })");
+  }
+  nlohmann::json stats(const std::string& file) { return nlohmann::json::parse(readFile(dir_ / file)); }
+};
+
+TEST_F(LightCacheCli, FramesBuildTheCacheOnceAndTheStatsReportIt) {
+  for (const char* algorithm : {"raymarch", "lobe"}) {
+    SCOPED_TRACE(algorithm);
+    const RunResult r = run(std::string("render s.json -o a.exr --frames 5 --stats-json a.json --algorithm ") + algorithm);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json s = stats("a.json");
+    EXPECT_EQ(s["light_cache_cells"], nlohmann::json::array({64, 64, 64}));  // auto on a cubic box
+    EXPECT_EQ(s["light_cache_builds"], 2);  // one slab per light, for five frames
+    EXPECT_EQ(s["light_cache_bytes"], 65 * 65 * 65 * 2 * 4);
+    EXPECT_GT(s["light_cache_ms"].get<double>(), 0.0);
+    EXPECT_EQ(s["passes"], 5);
+  }
+  const RunResult off = run("render s.json -o b.exr --stats-json b.json --set renderer.lightCache.resolution=0");
+  ASSERT_EQ(off.code, 0) << off.err;
+  EXPECT_EQ(stats("b.json")["light_cache_cells"], nlohmann::json::array({0, 0, 0}));
+  EXPECT_EQ(stats("b.json")["light_cache_builds"], 0);
+  EXPECT_EQ(stats("b.json")["light_cache_ms"], 0.0);
+}
+
+// Moving the point light is a new cache: the image changes where its light reaches the cloud.
+TEST_F(LightCacheCli, MovingALightChangesTheImage) {
+  ASSERT_EQ(run("render s.json -o a.exr --stats-json a.json").code, 0);
+  const RunResult r =
+      run("render s.json -o b.exr --stats-json b.json --set primitives.1.transform.position=[2,-2,-1]");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(stats("b.json")["light_cache_builds"], 2);
+  const ImageRGB a = readExr((dir_ / "a.exr").string()), b = readExr((dir_ / "b.exr").string());
+  int differing = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) differing += a.rgb[i] != b.rgb[i];
+  EXPECT_GT(differing, int(a.rgb.size()) / 10);
+}
+
+TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
+  const struct {
+    const char* set;
+    const char* message;  // the whole of stderr: one line
+  } cases[] = {
+      {"renderer.lightCache.resolution=\\\"high\\\"",
+       "narval: s.json: renderer.lightCache.resolution: expected \"auto\" or a number of cells (0 = off), got \"high\"\n"},
+      {"renderer.lightCache.resolution=-3",
+       "narval: s.json: renderer.lightCache.resolution: must be at least 0, got -3\n"},
+      {"renderer.lightCache.resolution=2000",
+       "narval: s.json: renderer.lightCache.resolution: must be at most 1024, got 2000\n"},
+      {"renderer.lightCache.resolution=2.5",
+       "narval: s.json: renderer.lightCache.resolution: expected an integer, got 2.5\n"},
+      {"renderer.raymarch.minTransmittance=1",
+       "narval: s.json: renderer.raymarch.minTransmittance: must be in [0, 1) (0 = never stop), got 1\n"},
+      {"renderer.lobe.viewSteps=0", "narval: s.json: renderer.lobe.viewSteps: must be at least 1, got 0\n"},
+      {"renderer.lobe.firstHitSteps=0", "narval: s.json: renderer.lobe.firstHitSteps: must be at least 1, got 0\n"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.set);
+    const RunResult r = run(std::string("render s.json -o x.exr --set ") + c.set);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err, c.message);
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "x.exr"));
+  }
+}
+
+}  // namespace
+}  // namespace narval::test
