@@ -21,7 +21,7 @@
 namespace narval {
 
 // renderer.lightCache.resolution "auto" (kLightCacheAuto): cells on the longest axis, chosen by
-// measurement (bench/light_cache_resolution.sh; bench/RESULTS.md).
+// measurement (bench/realtime_tuning.sh; bench/RESULTS.md).
 constexpr int kLightCacheAutoResolution = 64;
 
 // The cache's layout for `resolution` cells along the longest world-space axis of the medium's

@@ -39,21 +39,24 @@
  *    (vec3_basis flips where ω.z changes sign, which would print a seam).
  * 4. Transmittances by the midpoint rule (true step lengths, all channels, only the part inside
  *    the box): Tr(x0 → P_i) over view_steps samples, Tr(P_i → light) by light_cache_optical_depth
- *    (one lookup in the light-transmittance cache, or the exact march of shadow_steps), lights as points (march_light_as_point: a rectangle is a point at its
- *    centre with intensity Le·A·max(0, cos θ_light), as DESIGN.md allows for real-time kernels).
+ *    (one lookup in the light-transmittance cache, or the exact march of shadow_steps), lights as
+ *    points (march_light_as_point: a rectangle is a point at its centre with intensity
+ *    Le·A·max(0, cos θ_light), as DESIGN.md allows for real-time kernels).
  *    Shadow rays see only the medium, not other rectangles. cos θ_i = dot(normalize(P_i − light),
  *    −d_i): light propagating from the light to P_i, then from P_i towards c. albedo = σs/σt per
  *    channel (0 where σt = 0).
- * Economies that change no pixel: when L_b is exactly 0 the view transmittances are not marched
- * (their term is 0·Tr = 0 either way). Early termination of Tr(x0 → P_i) (min_transmittance ε > 0):
- * the march stops once every channel's partial τ exceeds −ln ε, so the value used is in
- * [Tr_true, ε) and each of the n terms is off by less than ε: |ΔL| < ε·L_b per channel.
+ * Economies: when L_b is exactly 0 the view transmittances are not marched (their term is 0·Tr = 0
+ * either way: no pixel changes). Early termination of Tr(x0 → P_i) (min_transmittance ε > 0): the
+ * march stops once every channel's partial τ exceeds −ln ε', ε' = ε / max(1, max channel of L_b),
+ * so the value used is in [Tr_true, ε') and each of the n terms is off by less than ε':
+ * |ΔL| < ε'·L_b ≤ ε per channel (raymarch.h says why ε is scaled by L_b).
  * No medium, a ray that misses the box (or meets a rectangle light first), or no density > 0 on the
  * segment: L = L_b exactly (march_background). Means divide by n (not multiply by 1/n), so n
  * transmittances of exactly 1 give exactly L_b.
  * Loops: the first-hit search (`steps` samples, then LOBE_BISECTIONS), n lobe points × (one march of
- * view_steps + lights × (one cache lookup or a march of shadow_steps)): all bounded by the scene's parameters; the only
- * open-ended walk is the DDA under each march, capped by its budget (majorant.h).
+ * view_steps + lights × (one cache lookup or a march of shadow_steps)): all bounded by the scene's
+ * parameters; the only open-ended walk is the DDA under each march, capped by its budget
+ * (majorant.h).
  * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density, phase value or
  * lobe point met on the way; STATUS_ITERATION_CAP from a DDA walk. No pdf: never
  * STATUS_NEGATIVE_PDF. */
@@ -65,7 +68,6 @@
 
 /* Halvings of the first-hit step: x0 is placed within Δ/64 past the density's zero crossing. */
 #define LOBE_BISECTIONS 6
-
 
 /* The pinhole primary ray through image point (px, py) (pixel units, (0,0) the top-left corner):
  * camera.h's mapping without the thin lens (DESIGN.md: the real-time kernels are pinhole). */
@@ -164,7 +166,9 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
   /* 4. Sums over the lobe points. */
   const int n = p->lobe_points;
   const int view_term = !vec3_is_zero(Lb);
-  const float tau_limit = p->min_transmittance > 0.0f ? -nv_log(p->min_transmittance) : NV_INFINITY;
+  const float tau_limit = p->min_transmittance > 0.0f
+                              ? -nv_log(p->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
+                              : NV_INFINITY;
   vec3 tr_sum = vec3_splat(0.0f), in_sum = vec3_splat(0.0f);
   for (int i = 0; i < n; ++i) {
     const nv_float4 q = dirs[i];

@@ -42,14 +42,17 @@
  * cache when it is on, else a march of shadow_steps samples.
  *
  * Early termination (min_transmittance = ε > 0; 0 never stops): the march stops after the step
- * where every channel of T fell below ε, and the pixel is L + T·L_b with the T reached. Error bound,
- * per channel: what the rest of the march would have added is Σ_{k'} T_{k'}·(S_{k'}/σt_{k'})·
- * (1 − e^{−σt_{k'}Δ}) (the energy-conserving step) ≤ T·max_{k'}(S/σt)·(1 − T_rest) ≤ T·A, with
- * A = sup of S/σt = albedo · Σ_lights (I/d²) · Σ_i aⁱ p(g cⁱ, μ) e^{−bⁱτ} over the rest of the
- * segment, and the L_b term changes from T·T_rest·L_b to T·L_b, by at most T·L_b; the two have
- * opposite signs, so |ΔL| ≤ T·max(A, L_b) < ε·max(A, L_b). A bound the host can evaluate: A ≤
- * max albedo · Σ_lights I/d_min² · p_max · Σ_{i<N} aⁱ, d_min the light's distance from the box
- * (tests/render/realtime_economy_test.cpp checks it).
+ * where every channel of T fell below ε' = ε / max(1, max channel of L_b), and the pixel is L + T·L_b
+ * with the T reached. Error bound, per channel: what the rest of the march would have added is
+ * Σ_{k'} T_{k'}·(S_{k'}/σt_{k'})·(1 − e^{−σt_{k'}Δ}) (the energy-conserving step) ≤ T·A·(1 − T_rest),
+ * with A = sup of S/σt = albedo · Σ_lights (I/d²) · Σ_i aⁱ p(g cⁱ, μ) e^{−bⁱτ} over the rest of the
+ * segment, and the L_b term changes from T·T_rest·L_b to T·L_b, by T·(1 − T_rest)·L_b; the two have
+ * opposite signs, so |ΔL| ≤ T·max(A, L_b) < ε·max(A, L_b)/max(1, L_b) ≤ ε·max(A, 1). Scaling ε by
+ * L_b keeps a dark pixel in front of a bright emitter (Listing 4.1's light behind the cloud, L_b =
+ * 20) from showing ε·L_b of light the medium hides: in display terms an absolute error ε = 10⁻³
+ * is under ΔL* = 1 even at black (L* = 903.3·Y below Y = 0.0089). A bound the host can evaluate:
+ * A ≤ max albedo · Σ_lights I/d_min² · p_max · Σ_{i<N} aⁱ, d_min the light's distance from the box
+ * (tests/render/light_cache_render_test.cpp checks it).
  *
  * Empty space: the `steps` samples are spread over the occupied majorant cells only (march_iter in
  * march.h), so empty parts of the box cost nothing and the step is shorter where there is medium.
@@ -116,13 +119,15 @@ typedef struct raymarch_accum {
 
 /* Marches the view ray origin + t·dir over its box segment `seg` in `steps` steps of equal true
  * length spread over the occupied cells (march_iter: empty cells are skipped), sampled at their
- * midpoints. Loops: `steps` samples (march_next, its piece walk capped by the DDA budget), each
+ * midpoints; stops once every channel of T is below t_stop (0: never; see "Early termination").
+ * Loops: `steps` samples (march_next, its piece walk capped by the DDA budget), each
  * with num_lights shadow marches of shadow_steps samples and `octaves` (≤ 16) terms: all bounded by
  * the scene's own parameters, no cap of their own. */
 static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                     GRID_PARAM, NV_CONSTANT const realtime_params* rp,
-                                    NV_GLOBAL const float* light_cache, NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, int steps,
-                                    NV_PRIVATE raymarch_accum* acc, NV_PRIVATE uint* status) {
+                                    NV_GLOBAL const float* light_cache, NV_PRIVATE const medium_segment* seg,
+                                    vec3 origin, vec3 dir, int steps, float t_stop, NV_PRIVATE raymarch_accum* acc,
+                                    NV_PRIVATE uint* status) {
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
   march_iter it = march_begin(m, GRID_ARG, seg, steps);
@@ -146,7 +151,7 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
                              raymarch_step_weight(x.z, e.z));
     acc->L = vec3_add(acc->L, vec3_mul(acc->T, vec3_scale(vec3_mul(S, w), dt)));
     acc->T = vec3_mul(acc->T, e);
-    if (vec3_max_component(acc->T) < rp->min_transmittance) break; /* early termination (above) */
+    if (vec3_max_component(acc->T) < t_stop) break; /* early termination (above) */
   }
   *status |= it.status;
 }
@@ -168,7 +173,8 @@ static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT
       raymarch_accum acc;
       acc.L = vec3_splat(0.0f);
       acc.T = vec3_splat(1.0f);
-      raymarch_segment(s, lights, GRID_ARG, rp, light_cache, &seg, r.origin, r.dir, rp->steps, &acc, status);
+      const float t_stop = rp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb));
+      raymarch_segment(s, lights, GRID_ARG, rp, light_cache, &seg, r.origin, r.dir, rp->steps, t_stop, &acc, status);
       L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
     }
   }

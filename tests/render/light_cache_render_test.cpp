@@ -183,39 +183,45 @@ TEST(LightCacheRender, RebuildsOnlyTheSlabsWhoseInputsChanged) {
   EXPECT_EQ(cache.slabsBuilt(), 7);
 }
 
-// Early termination (minTransmittance ε): the ray marcher stops once every channel of T < ε and
-// changes no pixel by more than ε·max(A, L_b) (raymarch.h), A = albedo·p·Σ I/d_min² with the
-// shadow transmittance taken as 1: 0.75·(1/4π)·5/2.5². The lobe's Tr(x0 → P_i) stop below ε
-// and move a pixel by less than ε·L_b (lobe.h). A dense box (σt = 32 per unit) makes both stop
-// early; the exact shadow marches (cache off) isolate the termination.
+// Early termination (minTransmittance ε): the ray marcher stops once every channel of T is below
+// ε' = ε / max(1, L_b) and changes no pixel by more than ε'·max(A, L_b) (raymarch.h), A =
+// albedo·p·Σ I/d_min² with the shadow transmittance taken as 1: 0.75·(1/4π)·5/2.5². The lobe's
+// Tr(x0 → P_i) stop below ε' and move a pixel by less than ε'·L_b (lobe.h). A dense box (σt = 32
+// per unit) makes both stop early; the exact shadow marches (cache off) isolate the termination.
+// Backgrounds 0.3 and 3: below and above 1, where ε' is ε scaled down.
 TEST(LightCacheRender, EarlyTerminationChangesNoPixelBeyondItsBound) {
-  const double eps = 0.01, Lb = 0.3, A = 0.75 / (4 * kPi) * 5 / (2.5 * 2.5);
-  const struct {
-    const char* algorithm;
-    const char* params;
-    double bound;
-  } kernels[] = {
-      {"raymarch", R"("raymarch": {"steps": 60, "shadowSteps": 10, "minTransmittance": %g})", eps * std::max(A, Lb)},
-      {"lobe", R"("lobe": {"lobePoints": 8, "depthFactor": 4, "lobeRadius": 0.2, "viewSteps": 40, "minTransmittance": %g})",
-       eps * Lb},
-  };
-  for (const auto& k : kernels) {
-    SCOPED_TRACE(k.algorithm);
-    auto renderer = [&](double e) {
-      char params[256];
-      std::snprintf(params, sizeof params, k.params, e);
-      return R"({"resolution": [24, 24], "algorithm": ")" + std::string(k.algorithm) +
-             R"(", "lightCache": {"resolution": 0}, )" + params + "}";
+  const double eps = 0.01, A = 0.75 / (4 * kPi) * 5 / (2.5 * 2.5);
+  for (double Lb : {0.3, 3.0}) {
+    const double epsPixel = eps / std::max(1.0, Lb);
+    const struct {
+      const char* algorithm;
+      const char* params;
+      double bound;
+    } kernels[] = {
+        {"raymarch", R"("raymarch": {"steps": 60, "shadowSteps": 10, "minTransmittance": %g})", epsPixel * std::max(A, Lb)},
+        {"lobe",
+         R"("lobe": {"lobePoints": 8, "depthFactor": 4, "lobeRadius": 0.2, "viewSteps": 40, "minTransmittance": %g})",
+         epsPixel * Lb},
     };
-    const RenderResult full = renderRt(litBoxJson(renderer(0), 16, "[0.3, 0.3, 0.3]"));
-    const RenderResult cut = renderRt(litBoxJson(renderer(eps), 16, "[0.3, 0.3, 0.3]"));
-    ASSERT_EQ(cut.stats.status, 0u);
-    int differing = 0;
-    const double err = maxAbsDiff(full.image, cut.image, &differing);
-    std::printf("[ early termination ] %s, eps %g: max |dL| %.3g (bound %.3g), %d values differ\n", k.algorithm, eps,
-                err, k.bound, differing);
-    EXPECT_LE(err, k.bound * (1 + 1e-5) + 1e-7);
-    EXPECT_GT(differing, 0);  // the marches did stop early
+    const std::string background = "[" + std::to_string(Lb) + ", " + std::to_string(Lb) + ", " + std::to_string(Lb) + "]";
+    for (const auto& k : kernels) {
+      SCOPED_TRACE(std::string(k.algorithm) + " in front of " + background);
+      auto renderer = [&](double e) {
+        char params[256];
+        std::snprintf(params, sizeof params, k.params, e);
+        return R"({"resolution": [24, 24], "algorithm": ")" + std::string(k.algorithm) +
+               R"(", "lightCache": {"resolution": 0}, )" + params + "}";
+      };
+      const RenderResult full = renderRt(litBoxJson(renderer(0), 16, background));
+      const RenderResult cut = renderRt(litBoxJson(renderer(eps), 16, background));
+      ASSERT_EQ(cut.stats.status, 0u);
+      int differing = 0;
+      const double err = maxAbsDiff(full.image, cut.image, &differing);
+      std::printf("[ early termination ] %s, eps %g, background %g: max |dL| %.3g (bound %.3g), %d values differ\n",
+                  k.algorithm, eps, Lb, err, k.bound, differing);
+      EXPECT_LE(err, k.bound * (1 + 1e-5) + 1e-7);
+      EXPECT_GT(differing, 0);  // the marches did stop early
+    }
   }
 }
 
