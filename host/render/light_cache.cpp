@@ -1,7 +1,6 @@
 #include "render/light_cache.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 
@@ -85,7 +84,6 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
     if (all || std::memcmp(&lights_[size_t(l)], &dev.scene.lights[size_t(l)], sizeof(light_params)) != 0)
       stale.push_back(l);
   if (stale.empty()) return;
-  const auto tLaunch = std::chrono::steady_clock::now();  // the program build above is not the cache's
   paramBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(params),
                          const_cast<realtime_params*>(&params));
   rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
@@ -97,8 +95,9 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   const size_t local = 64, global = (nodes + local - 1) / local * local;
   for (int l : stale) {
     kernel_.setArg(arg + 1, cl_int(l));
-    launchAndWait(rt, kernel_, cl::NDRange(global), cl::NDRange(local), "the light-transmittance cache",
-                  deviceSceneBytes(dev.scene) + bytes_);
+    const cl::Event ev = launchAndWait(rt, kernel_, cl::NDRange(global), cl::NDRange(local),
+                                       "the light-transmittance cache", deviceSceneBytes(dev.scene) + bytes_);
+    buildMs_ += eventSeconds(ev) * 1e3;
     lights_[size_t(l)] = dev.scene.lights[size_t(l)];
     ++slabsBuilt_;
   }
@@ -106,7 +105,6 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   rt.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof st, &st);
   status_ |= st;
   mediumKey_ = key;
-  buildMs_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tLaunch).count();
 }
 
 }  // namespace narval

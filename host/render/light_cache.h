@@ -46,7 +46,9 @@ class DeviceLightCache {
               const std::string& sceneFile);
   const cl::Buffer& buffer() const { return buffer_; }
   int slabsBuilt() const { return slabsBuilt_; }  // light slabs built over this object's life
-  double buildMs() const { return buildMs_; }     // their launches' wall clock (program build apart)
+  // Their launches' time by profiling events, as the frames are timed (the program build and the
+  // driver's compile on a first launch are not in it).
+  double buildMs() const { return buildMs_; }
   size_t bytes() const { return bytes_; }
   uint32_t status() const { return status_; }     // STATUS_* bits the builds met
 

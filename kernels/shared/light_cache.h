@@ -98,10 +98,7 @@ static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_CO
   if (p.x >= 0.0f && p.y >= 0.0f && p.z >= 0.0f && p.x <= dims.x && p.y <= dims.y && p.z <= dims.z)
     return light_cache_column_at(c, cache, light, dims, p); /* inside: no ray to clip */
   medium_segment seg;
-  if (!medium_intersect(m, x, dir, 0.0f, dist, &seg)) {
-    if (!(vec3_is_finite(x) && vec3_is_finite(dir) && dist == dist)) *status |= STATUS_NAN;
-    return 0.0f;
-  }
+  if (!march_clip(m, x, dir, dist, &seg, status)) return 0.0f;
   return light_cache_column_at(c, cache, light, dims, vec3_madd(seg.o, seg.d, seg.t0));
 }
 

@@ -86,6 +86,15 @@ static inline int march_next(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRIVATE f
   return 1;
 }
 
+/* The part of the ray origin + t·dir, t in [0, dist], inside the medium's box, into *seg; 0 when
+ * there is none. A NaN ray misses every box: it is flagged rather than passed off as clear air. */
+static inline int march_clip(NV_CONSTANT const medium_params* m, vec3 origin, vec3 dir, float dist,
+                             NV_PRIVATE medium_segment* seg, NV_PRIVATE uint* status) {
+  if (medium_intersect(m, origin, dir, 0.0f, dist, seg)) return 1;
+  if (!(vec3_is_finite(origin) && vec3_is_finite(dir) && dist == dist)) *status |= STATUS_NAN;
+  return 0;
+}
+
 /* Optical depth τ from `origin` over `dist` along unit `dir`: `steps` midpoint samples over the
  * occupied part of the segment inside the box, Σ σt·Δ. 0 outside the box. The ray marcher's
  * octaves need τ itself (exp(−bⁱτ)), which survives where exp(−τ) underflows. The walk's status
@@ -97,11 +106,7 @@ static inline int march_next(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRIVATE f
 static inline vec3 march_optical_depth_limited(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
                                                float dist, int steps, float tau_limit, NV_PRIVATE uint* status) {
   medium_segment seg;
-  if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) {
-    /* A NaN ray misses every box: say so rather than pass it off as clear air. */
-    if (!(vec3_is_finite(origin) && vec3_is_finite(dir) && dist == dist)) *status |= STATUS_NAN;
-    return vec3_splat(0.0f);
-  }
+  if (!march_clip(m, origin, dir, dist, &seg, status)) return vec3_splat(0.0f);
   march_iter it = march_begin(m, GRID_ARG, &seg, steps);
   const float sum_limit = tau_limit / it.delta; /* on Σσt, before the scaling by Δ */
   vec3 tau = vec3_splat(0.0f);
@@ -131,10 +136,7 @@ static inline vec3 march_transmittance(NV_CONSTANT const medium_params* m, GRID_
 static inline float march_column_density(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
                                          float dist, int steps, NV_PRIVATE uint* status) {
   medium_segment seg;
-  if (!medium_intersect(m, origin, dir, 0.0f, dist, &seg)) {
-    if (!(vec3_is_finite(origin) && vec3_is_finite(dir) && dist == dist)) *status |= STATUS_NAN;
-    return 0.0f;
-  }
+  if (!march_clip(m, origin, dir, dist, &seg, status)) return 0.0f;
   march_iter it = march_begin(m, GRID_ARG, &seg, steps);
   float column = 0.0f, t;
   while (march_next(&it, GRID_ARG, &t)) column += grid_density(GRID_ARG, vec3_madd(seg.o, seg.d, t));

@@ -147,8 +147,8 @@ TEST(LightCacheRender, DeviceBuildMatchesTheHost) {
 }
 
 // Rebuilt only when the medium, that light or the shadow quadrature changes: update() on the same
-// scene builds nothing; moving one light rebuilds its slab alone; another density or step count
-// rebuilds every slab.
+// scene or after a camera move builds nothing; moving one light rebuilds its slab alone; another
+// density or step count rebuilds every slab.
 TEST(LightCacheRender, RebuildsOnlyTheSlabsWhoseInputsChanged) {
   const DenseGrid cloud = makeCloud(16, 2);
   auto scene = [](const std::string& renderer, double density = 4) {
@@ -165,6 +165,12 @@ TEST(LightCacheRender, RebuildsOnlyTheSlabsWhoseInputsChanged) {
   EXPECT_EQ(cache.slabsBuilt(), 2);
   cache.update(runtime(), devA, pa, "a");
   EXPECT_EQ(cache.slabsBuilt(), 2);  // nothing changed: nothing built
+
+  Scene camera = a;
+  camera.camera.position = {1.0f, 0.5f, -6.0f};  // a camera move
+  DeviceSceneBuffers devCamera(runtime(), camera, &cloud);
+  cache.update(runtime(), devCamera, realtimeParams(camera, devCamera.scene), "camera");
+  EXPECT_EQ(cache.slabsBuilt(), 2);  // the cache does not depend on the camera
 
   Scene moved = a;
   moved.primitives[1].transform.position = {-1.5f, 2.5f, -1.0f};  // the point light
