@@ -46,7 +46,8 @@ static inline vec3 light_cache_node_point(NV_CONSTANT const light_cache_params* 
 }
 
 /* What node `node` of light l's slab holds: the column density from the node to the light over
- * the kernel's shadow quadrature; 0 when the light sits on the node (nothing lies between). */
+ * the kernel's shadow quadrature; 0 when the light sits on the node (nothing lies between).
+ * Status word: STATUS_NAN for a NaN node point or column; STATUS_ITERATION_CAP from a DDA walk. */
 static inline float light_cache_build_node(NV_CONSTANT const medium_params* m, GRID_PARAM,
                                            NV_CONSTANT const light_cache_params* c, int shadow_steps,
                                            NV_CONSTANT const light_params* l, int node, NV_PRIVATE uint* status) {
@@ -58,7 +59,9 @@ static inline float light_cache_build_node(NV_CONSTANT const medium_params* m, G
     return 0.0f;
   }
   const float dist = nv_sqrt(d2);
-  return march_column_density(m, GRID_ARG, x, vec3_scale(to, 1.0f / dist), dist, shadow_steps, status);
+  const float column = march_column_density(m, GRID_ARG, x, vec3_scale(to, 1.0f / dist), dist, shadow_steps, status);
+  if (column != column) *status |= STATUS_NAN; /* a NaN density on the way: said, not cached silently */
+  return column;
 }
 
 /* One axis of a lookup: the lower node and the weight of the upper one for coordinate u (in node

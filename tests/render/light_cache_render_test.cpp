@@ -146,6 +146,25 @@ TEST(LightCacheRender, DeviceBuildMatchesTheHost) {
   EXPECT_EQ(cache.status(), 0u);
 }
 
+// The build kernel's status word is live: a NaN voxel (the loaders refuse them; a grid handed over
+// directly is not checked) poisons the columns through it, and the build says so.
+TEST(LightCacheRender, ANanVoxelRaisesTheBuildsStatus) {
+  DenseGrid g = makeCloud(16, 2);
+  const Scene scene = sceneFromJson(litCloudJson(R"({"resolution": [8, 8], "algorithm": "raymarch", "storage": "buffer",
+                                                     "lightCache": {"resolution": 8}})"));
+  DeviceLightCache clean, poisoned;
+  DeviceSceneBuffers devClean(runtime(), scene, &g);
+  clean.update(runtime(), devClean, realtimeParams(scene, devClean.scene), "clean");
+  EXPECT_EQ(clean.status(), 0u);
+  g.data[size_t(8 + 16 * (8 + 16 * 8))] = NAN;  // the centre voxel
+  DeviceSceneBuffers devNan(runtime(), scene, &g);
+  poisoned.update(runtime(), devNan, realtimeParams(scene, devNan.scene), "nan");
+  EXPECT_TRUE(poisoned.status() & STATUS_NAN);
+  const RenderResult r = renderRealtime(runtime(), scene, &g, 1, RenderOptions{});
+  EXPECT_TRUE(r.stats.status & STATUS_NAN);
+  EXPECT_EQ(r.stats.nanPixels, 0);  // written as 0, never NaN
+}
+
 // Rebuilt only when the medium, that light or the shadow quadrature changes: update() on the same
 // scene or after a camera move builds nothing; moving one light rebuilds its slab alone; another
 // density or step count rebuilds every slab.
