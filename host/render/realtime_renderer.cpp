@@ -103,7 +103,7 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
       kernel.setArg(arg + 2, lightCache.buffer());
     }
     const auto tf = std::chrono::steady_clock::now();
-    const cl::Event ev = launchAndWait(rt, kernel, global, local, algorithm, deviceBytes);
+    const cl::Event ev = launchAndWait(rt, kernel, global, local, algorithm, deviceBytes + lightCache.bytes());
     wallMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tf).count());
     kernelMs.push_back(eventSeconds(ev) * 1e3);
     if (options.progress) options.progress(f + 1, requested);

@@ -92,6 +92,14 @@ TEST(LightCache, LayoutFollowsTheBoxsLongestWorldAxis) {
   EXPECT_EQ(c.nz, 17);
   EXPECT_EQ(lightCacheLayout(ds, 0).nx, 0);  // off
   EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto).nx, kLightCacheAutoResolution + 1);
+  // auto halves its resolution until the slabs fit the device's largest allocation: at 64 cells
+  // 65·17·33 nodes · 4 bytes = 145860 bytes for the one light; a 100000-byte device gets 32 cells
+  // (33·9·17 nodes, 20196 bytes). An explicit resolution is kept (its allocation then fails with
+  // a message naming the key).
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 145860).nx, 65);
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 100000).nx, 33);
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 100000).ny, 9);
+  EXPECT_EQ(lightCacheLayout(ds, 64, 100000).nx, 65);
   // The corner nodes sit on the box's corners in world space.
   const vec3 far = affine_point(c.index_to_world, light_cache_node_point(&c, vec3_from4(ds.params.medium.dims),
                                                                          light_cache_nodes(&c) - 1));
