@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # bench/device/gpu_bench.sh [OUTDIR]: on the GPU machine (after `source bench/device/setup.sh`):
 # the three shipped scenes at 1200x600, path tracing 256 spp per grid storage and majorant, and
-# 20 frames of raymarch and lobe per storage; prints a Markdown table. Not a test.
+# 20 frames of raymarch and lobe per storage; prints a Markdown table; then bench/realtime_frames.sh
+# at 1280x720. Not a test.
 set -u
 cd "$(dirname "$0")/../.."
 N=$PWD/build/narval
@@ -32,3 +33,6 @@ for f in sorted(glob.glob(os.path.join(sys.argv[1], "*.json"))):
     print(f"| {os.path.basename(f)[:-5]} | {j.get('storage')} | {j.get('majorant', '')} | {j['seconds']:.3f} "
           f"| {j['samples_per_second'] / 1e6:.1f} | {ms} |")
 PY
+# The real-time kernels at 1280x720 with the light-transmittance cache off and on, on the four
+# shipped scenes (the 2 ms per frame GPU budget; no path-traced references here).
+bench/realtime_frames.sh --resolutions 1280x720 --ref-resolutions "" --frames 20 --out "$out/realtime"
