@@ -202,6 +202,10 @@ int runRender(const RenderArgs& a) {
               << " ms, then median " << s.frames.medianKernelMs << " ms (min " << s.frames.minKernelMs << ", max "
               << s.frames.maxKernelMs << ") per frame by profiling events, median " << s.frames.medianWallMs
               << " ms by wall clock\n";
+  if (s.lightCacheBuilds > 0)
+    std::cout << "light cache: " << s.lightCacheCells[0] << "x" << s.lightCacheCells[1] << "x" << s.lightCacheCells[2]
+              << " cells, " << s.lightCacheBuilds << (s.lightCacheBuilds == 1 ? " light" : " lights") << " built in "
+              << s.lightCacheMs << " ms (not in the frame times)\n";
   std::cout << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
             << s.algorithm << ", ";
   if (realtime)

@@ -46,12 +46,15 @@ TEST_F(LightCacheCli, FramesBuildTheCacheOnceAndTheStatsReportIt) {
     EXPECT_EQ(s["light_cache_bytes"], 65 * 65 * 65 * 2 * 4);
     EXPECT_GT(s["light_cache_ms"].get<double>(), 0.0);
     EXPECT_EQ(s["passes"], 5);
+    EXPECT_NE(r.out.find("\nlight cache: 64x64x64 cells, 2 lights built in "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(" ms (not in the frame times)\n"), std::string::npos) << r.out;
   }
   const RunResult off = run("render s.json -o b.exr --stats-json b.json --set renderer.lightCache.resolution=0");
   ASSERT_EQ(off.code, 0) << off.err;
   EXPECT_EQ(stats("b.json")["light_cache_cells"], nlohmann::json::array({0, 0, 0}));
   EXPECT_EQ(stats("b.json")["light_cache_builds"], 0);
   EXPECT_EQ(stats("b.json")["light_cache_ms"], 0.0);
+  EXPECT_EQ(off.out.find("light cache:"), std::string::npos);
 }
 
 // Moving the point light is a new cache: the image changes where its light reaches the cloud.
