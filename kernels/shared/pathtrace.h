@@ -55,14 +55,15 @@ static inline vec3 pathtrace_direct(NV_CONSTANT const scene_params* s, NV_CONSTA
   return sum;
 }
 
-static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                    GRID_PARAM, int px, int py, uint sample, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
-  const uint pixel = (uint)py * (uint)s->camera.width + (uint)px;
-  rng_state rng = rng_init(s->seed, pixel, sample);
-  const float jx = rng_uniform(&rng), jy = rng_uniform(&rng);
-  const float lu = rng_uniform(&rng), lv = rng_uniform(&rng);
-  const ray3 cam = camera_ray(&s->camera, (float)px + jx, (float)py + jy, lu, lv);
-  vec3 o = cam.origin, d = cam.dir;
+/* Radiance arriving at o from the direction −d, by one path: the ray o + t·d, then up to max_bounces
+ * real scattering events. unscattered_emitters 0 drops the emitter the first segment may hit (the
+ * unscattered light of the lights, which the ray marcher adds itself: the multiple-scattering
+ * cache, ms_cache.h); the background seen through the medium is kept either way. Non-finite
+ * results are left to the caller's check. */
+static inline vec3 pathtrace_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                      GRID_PARAM, vec3 o, vec3 d, int unscattered_emitters, NV_PRIVATE rng_state* rng_in,
+                                      NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+  rng_state rng = *rng_in;
   vec3 L = vec3_splat(0.0f), beta = vec3_splat(1.0f);
   float prev_phase_pdf = 0.0f; /* 0: the ray left the camera, no MIS on what it hits */
   int depth = 0;
@@ -98,7 +99,7 @@ static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTA
       }
     }
     if (light_hit >= 0) {
-      if (front) {
+      if (front && (unscattered_emitters || depth > 0)) {
         float w = 1.0f;
         if (prev_phase_pdf > 0.0f)
           w = mis_power_heuristic(prev_phase_pdf, light_pdf_rectangle(&lights[light_hit], d, t_surf));
@@ -109,6 +110,18 @@ static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTA
     }
     break;
   }
+  *rng_in = rng;
+  return L;
+}
+
+static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                    GRID_PARAM, int px, int py, uint sample, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+  const uint pixel = (uint)py * (uint)s->camera.width + (uint)px;
+  rng_state rng = rng_init(s->seed, pixel, sample);
+  const float jx = rng_uniform(&rng), jy = rng_uniform(&rng);
+  const float lu = rng_uniform(&rng), lv = rng_uniform(&rng);
+  const ray3 cam = camera_ray(&s->camera, (float)px + jx, (float)py + jy, lu, lv);
+  const vec3 L = pathtrace_radiance(s, lights, GRID_ARG, cam.origin, cam.dir, 1, &rng, status TRACK_COUNTERS_ARG);
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);
