@@ -7,8 +7,8 @@ __kernel void light_cache_build(__constant scene_params* scene, __constant light
                                 __constant realtime_params* params, int light, __global float* cache,
                                 __global uint* status_word) {
   const int node = get_global_id(0);
-  __constant light_cache_params* c = &params->light_cache;
-  const int nodes = light_cache_nodes(c);
+  __constant node_grid_params* c = &params->light_cache;
+  const int nodes = node_grid_count(c);
   if (node >= nodes) return;
   uint status = 0u;
   cache[(size_t)light * (size_t)nodes + (size_t)node] =

@@ -10,8 +10,8 @@
 
 namespace narval {
 
-light_cache_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes) {
-  light_cache_params c{};
+node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes) {
+  node_grid_params c{};
   const scene_params& sp = ds.params;
   if (resolution == 0 || !sp.has_medium) return c;
   int cells = resolution == kLightCacheAuto ? kLightCacheAutoResolution : resolution;
@@ -37,8 +37,8 @@ light_cache_params lightCacheLayout(const DeviceScene& ds, int resolution, size_
 }
 
 std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view* grid, const realtime_params& params) {
-  const light_cache_params& c = params.light_cache;
-  const int nodes = light_cache_nodes(&c);
+  const node_grid_params& c = params.light_cache;
+  const int nodes = node_grid_count(&c);
   std::vector<float> cache(size_t(nodes) * size_t(ds.params.num_lights));
   uint32_t status = 0;
   for (int l = 0; l < ds.params.num_lights; ++l)
@@ -59,7 +59,7 @@ std::string bytesOf(const T& v) {
 
 void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params,
                               const std::string& sceneFile) {
-  const light_cache_params& c = params.light_cache;
+  const node_grid_params& c = params.light_cache;
   if (c.nx <= 0) throw std::invalid_argument("DeviceLightCache::update: the cache is off (nx = 0)");
   const int numLights = dev.scene.params.num_lights;
   const size_t nodes = size_t(c.nx) * size_t(c.ny) * size_t(c.nz);

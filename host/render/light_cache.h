@@ -30,7 +30,7 @@ constexpr int kLightCacheAutoResolution = 64;
 // With kLightCacheAuto the resolution is halved until every light's slabs fit in `maxAllocBytes`
 // (the device's largest allocation); an explicit resolution is kept (the allocation then fails
 // with a message naming renderer.lightCache.resolution).
-light_cache_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes = SIZE_MAX);
+node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes = SIZE_MAX);
 
 // The column densities of every light's slab computed on the host with the shared header (what the
 // device builds; unit tests and the native baseline use it). `grid` reads the medium's density.

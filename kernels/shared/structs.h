@@ -76,16 +76,15 @@ typedef struct medium_params {
   majorant_grid_params majorant_grid; /* density bounds per cell: empty space is skipped */
 } medium_params;
 
-/* The light-transmittance cache (kernels/shared/light_cache.h): per light, nx·ny·nz nodes spanning
- * the medium's index box [0, dims] corner to corner, each holding the column density ∫ρ ds from the
- * node to the light. nx = 0: no cache, the kernels march their shadow rays. */
-typedef struct light_cache_params {
+/* A grid of nodes spanning the medium's index box corner to corner (kernels/shared/node_grid.h):
+ * the layout of the real-time caches. nx = 0: no grid. */
+typedef struct node_grid_params {
   nv_affine index_to_world; /* node points to world space (the inverse of medium.world_to_index) */
   int nx;
   int ny;
   int nz;
   int pad0;
-} light_cache_params;
+} node_grid_params;
 
 /* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
 typedef struct realtime_params {
@@ -101,7 +100,7 @@ typedef struct realtime_params {
   int view_steps;       /* lobe: samples of each transmittance from the first hit to a lobe point */
   float min_transmittance; /* view marches stop once every channel's transmittance is below it; 0: never */
   int pad0;
-  light_cache_params light_cache;
+  node_grid_params light_cache; /* the light-transmittance cache (light_cache.h); nx = 0: off */
 } realtime_params;
 
 typedef struct scene_params {

@@ -37,8 +37,8 @@
   F(realtime_params, lobe_points) F(realtime_params, view_steps)                                  \
   F(realtime_params, min_transmittance) F(realtime_params, pad0) F(realtime_params, light_cache)  \
   F(realtime_params, light_cache.nz)                                                              \
-  S(light_cache_params) F(light_cache_params, index_to_world) F(light_cache_params, nx)           \
-  F(light_cache_params, ny) F(light_cache_params, nz) F(light_cache_params, pad0)
+  S(node_grid_params) F(node_grid_params, index_to_world) F(node_grid_params, nx)           \
+  F(node_grid_params, ny) F(node_grid_params, nz) F(node_grid_params, pad0)
 
 #ifdef __OPENCL_C_VERSION__
 

@@ -86,7 +86,7 @@ TEST(LightCache, LayoutFollowsTheBoxsLongestWorldAxis) {
   std::string json = boxWithPointLight("[0, 0, 3]");
   json.replace(json.find("\"scale\": [1, 1, 1]"), 18, "\"scale\": [4, 1, 2]");
   const DeviceScene ds = buildDeviceScene(parseScene(json, "layout.json"), nullptr);
-  const light_cache_params c = lightCacheLayout(ds, 32);
+  const node_grid_params c = lightCacheLayout(ds, 32);
   EXPECT_EQ(c.nx, 33);
   EXPECT_EQ(c.ny, 9);
   EXPECT_EQ(c.nz, 17);
@@ -101,8 +101,8 @@ TEST(LightCache, LayoutFollowsTheBoxsLongestWorldAxis) {
   EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 100000).ny, 9);
   EXPECT_EQ(lightCacheLayout(ds, 64, 100000).nx, 65);
   // The corner nodes sit on the box's corners in world space.
-  const vec3 far = affine_point(c.index_to_world, light_cache_node_point(&c, vec3_from4(ds.params.medium.dims),
-                                                                         light_cache_nodes(&c) - 1));
+  const vec3 far = affine_point(c.index_to_world, node_grid_point(&c, vec3_from4(ds.params.medium.dims),
+                                                                         node_grid_count(&c) - 1));
   EXPECT_NEAR(far.x, 2.0f, 1e-6f);
   EXPECT_NEAR(far.y, 0.5f, 1e-6f);
   EXPECT_NEAR(far.z, 1.0f, 1e-6f);
@@ -128,9 +128,9 @@ TEST(LightCache, PointLightOutsideMatchesTheChordInsideTheBoxWithinTheTrilinearB
     const double h = 1.0 / cells, bound = 2.0 * h * h / 8 * (0.16 + 0.16 + 0.1024) + 1e-5;
     // The nodes themselves hold the chord, to float rounding.
     const vec3 dims = vec3_from4(c.ds.params.medium.dims);
-    for (int n = 0; n < light_cache_nodes(&c.params.light_cache); ++n) {
+    for (int n = 0; n < node_grid_count(&c.params.light_cache); ++n) {
       const vec3 w = affine_point(c.params.light_cache.index_to_world,
-                                  light_cache_node_point(&c.params.light_cache, dims, n));
+                                  node_grid_point(&c.params.light_cache, dims, n));
       const double x[3] = {w.x, w.y, w.z};
       ASSERT_NEAR(c.slabs[size_t(n)], lengthInside(x, light), 2e-6) << "node " << n;
     }
@@ -195,13 +195,13 @@ TEST(LightCache, LightOnANodeGivesZeroThere) {
   for (const char* pos : {"[0, 0, 0]", "[-0.5, -0.5, -0.5]"}) {
     SCOPED_TRACE(pos);
     const Cache c = buildCache(boxWithPointLight(pos), 8);
-    const light_cache_params& lc = c.params.light_cache;
+    const node_grid_params& lc = c.params.light_cache;
     const int centre = std::string(pos) == "[0, 0, 0]" ? 4 : 0;
     const int node = centre + lc.nx * (centre + lc.ny * centre);
     EXPECT_EQ(c.slabs[size_t(node)], 0.0f);
     if (centre == 4) EXPECT_NEAR(c.slabs[size_t(node + 1)], 1.0 / 8, 1e-6);  // (the corner's run along edges)
     const vec3 dims = vec3_from4(c.ds.params.medium.dims);
-    const float at = light_cache_column_at(&lc, c.slabs.data(), 0, dims, light_cache_node_point(&lc, dims, node));
+    const float at = light_cache_column_at(&lc, c.slabs.data(), 0, dims, node_grid_point(&lc, dims, node));
     EXPECT_NEAR(at, 0.0f, 1e-6f);
   }
 }
