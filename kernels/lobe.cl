@@ -1,12 +1,14 @@
 /* lobe.cl: thin entry point over shared/lobe.h (Lobe Estimator, DESIGN.md "lobe"). One work-item
  * per pixel, one deterministic estimate through the pixel centre; the global size is padded to a
  * multiple of the local size, so work-items past the image return at once. light_cache holds the
- * light-transmittance cache (a one-float placeholder when it is off). */
+ * light-transmittance cache (a one-float placeholder when it is off); ms_cache, part of the
+ * signature the real-time kernels share, is the ray marcher's and not read here. */
 #include "shared/lobe.h"
 
 __kernel void lobe(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
                    __constant realtime_params* params, __global const float4* lobe_directions,
-                   __global const float* light_cache, __global float4* out, __global uint* status_word) {
+                   __global const float* light_cache, __global const float* ms_cache, __global float4* out,
+                   __global uint* status_word) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
   uint status = 0u;

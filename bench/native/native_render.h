@@ -112,6 +112,8 @@ inline void prepareRealtimeInputs(const Scene& scene, const DeviceScene& ds, Nat
     const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
     o.lobeDirections = lobeDirections(o.realtime.lobe_points, g, scene.renderer.seed);
   }
+  if (o.realtime.ms_cache.nx > 0)
+    throw std::invalid_argument("narval-native: the multiple-scattering cache is built on OpenCL devices only");
   if (o.realtime.light_cache.nx > 0) {
     const grid_view gv = nativeGridView(ds, o);
     o.lightCache = buildLightCacheOnHost(ds, &gv, o.realtime);
@@ -162,7 +164,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
           }
           L = vec3_make(ax, ay, az);
         } else if (kind == 1) {
-          L = raymarch_pixel(sp, lights, grid, rp, cache, x, y, &status);
+          L = raymarch_pixel(sp, lights, grid, rp, cache, nullptr, x, y, &status);
         } else {
           L = lobe_pixel(sp, lights, grid, rp, dirs, cache, x, y, &status);
         }

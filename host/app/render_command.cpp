@@ -73,6 +73,10 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"light_cache_bytes", s.lightCacheBytes},
           {"light_cache_builds", s.lightCacheBuilds},
           {"light_cache_ms", s.lightCacheMs},
+          {"ms_cache_cells", {s.msCacheCells[0], s.msCacheCells[1], s.msCacheCells[2]}},
+          {"ms_cache_paths", s.msCachePaths},
+          {"ms_cache_builds", s.msCacheBuilds},
+          {"ms_cache_ms", s.msCacheMs},
           {"status",
            {{"nan", (s.status & STATUS_NAN) != 0},
             {"negative_pdf", (s.status & STATUS_NEGATIVE_PDF) != 0},
@@ -206,6 +210,10 @@ int runRender(const RenderArgs& a) {
     std::cout << "light cache: " << s.lightCacheCells[0] << "x" << s.lightCacheCells[1] << "x" << s.lightCacheCells[2]
               << " cells, " << s.lightCacheBuilds << (s.lightCacheBuilds == 1 ? " light" : " lights") << " built in "
               << s.lightCacheMs << " ms (not in the frame times)\n";
+  if (s.msCacheBuilds > 0)
+    std::cout << "multiple-scattering cache: " << s.msCacheCells[0] << "x" << s.msCacheCells[1] << "x"
+              << s.msCacheCells[2] << " cells, " << s.msCachePaths << " paths per node in " << s.msCacheMs
+              << " ms (not in the frame times)\n";
   std::cout << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
             << s.algorithm << ", ";
   if (realtime)

@@ -1,37 +1,21 @@
 #include "render/light_cache.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 
 #include "render/device_allocation.h"
+#include "render/node_grid.h"
 #include "render/render_common.h"
 #include "shared/light_cache.h"
 
 namespace narval {
 
 node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes) {
-  node_grid_params c{};
-  const scene_params& sp = ds.params;
-  if (resolution == 0 || !sp.has_medium) return c;
   int cells = resolution == kLightCacheAuto ? kLightCacheAutoResolution : resolution;
-  const medium_params& m = sp.medium;
-  c.index_to_world = affineInverse(m.world_to_index);
-  // World length of each box edge: the index-to-world map's column times the box's index extent.
-  const float dims[3] = {m.dims.x, m.dims.y, m.dims.z};
-  float len[3];
-  for (int a = 0; a < 3; ++a) {
-    const float col[3] = {(&c.index_to_world.row[0].x)[a], (&c.index_to_world.row[1].x)[a],
-                          (&c.index_to_world.row[2].x)[a]};
-    len[a] = dims[a] * std::sqrt(col[0] * col[0] + col[1] * col[1] + col[2] * col[2]);
-  }
-  const float longest = std::max({len[0], len[1], len[2]});
-  int* nodes[3] = {&c.nx, &c.ny, &c.nz};
   for (;;) {
-    for (int a = 0; a < 3; ++a)
-      *nodes[a] = 1 + std::max(1, int(std::lround(double(cells) * len[a] / longest)));
-    const size_t bytes = size_t(c.nx) * size_t(c.ny) * size_t(c.nz) * size_t(std::max(1, sp.num_lights)) * sizeof(float);
-    if (resolution != kLightCacheAuto || bytes <= maxAllocBytes || cells == 1) return c;
+    const node_grid_params c = nodeGridLayout(ds, cells);
+    const size_t bytes = nodeGridCount(c) * size_t(std::max(1, ds.params.num_lights)) * sizeof(float);
+    if (resolution != kLightCacheAuto || bytes <= maxAllocBytes || cells <= 1) return c;
     cells /= 2;
   }
 }

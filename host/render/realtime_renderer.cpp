@@ -6,6 +6,8 @@
 #include "render/device_allocation.h"
 #include "render/device_scene.h"
 #include "render/light_cache.h"
+#include "render/ms_cache.h"
+#include "render/node_grid.h"
 #include "render/lobe_directions.h"
 #include "render/majorant_options.h"
 #include "render/render_common.h"
@@ -22,7 +24,7 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   p.shadow_steps = lobe ? r.lobe.shadowSteps : r.raymarch.shadowSteps;
   p.view_steps = r.lobe.viewSteps;
   p.min_transmittance = lobe ? r.lobe.minTransmittance : r.raymarch.minTransmittance;
-  p.octaves = r.raymarch.octaves;
+  p.octaves = r.raymarch.multipleScattering == MultipleScattering::Octaves ? r.raymarch.octaves : 1;
   p.octave_a = r.raymarch.octaveScattering;
   p.octave_b = r.raymarch.octaveExtinction;
   p.octave_c = r.raymarch.octavePhase;
@@ -30,6 +32,8 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   p.lobe_radius = r.lobe.lobeRadius;
   p.lobe_points = r.lobe.lobePoints;
   p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
+  if (!lobe && r.raymarch.multipleScattering == MultipleScattering::Cache)
+    p.ms_cache = nodeGridLayout(ds, r.raymarch.msCache.resolution);
   return p;
 }
 
@@ -61,6 +65,7 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
 
   const realtime_params params = realtimeParams(scene, dev.scene, rt.selected.info.maxAllocBytes);
   DeviceLightCache lightCache;
+  DeviceMsCache msCache;
   cl::Buffer noCache;
   const scene_params& sp = dev.scene.params;
   const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
@@ -82,12 +87,11 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
   kernel.setArg(arg + 0, paramBuf);
   kernel.setArg(arg + 1, dirBuf);
-  kernel.setArg(arg + 3, outBuf);
-  kernel.setArg(arg + 4, statusBuf);
-  if (params.light_cache.nx == 0) {
-    noCache = cl::Buffer(rt.context, CL_MEM_READ_ONLY, sizeof(float));  // never read
-    kernel.setArg(arg + 2, noCache);
-  }
+  kernel.setArg(arg + 4, outBuf);
+  kernel.setArg(arg + 5, statusBuf);
+  noCache = cl::Buffer(rt.context, CL_MEM_READ_ONLY, sizeof(float));  // for a cache that is off: never read
+  if (params.light_cache.nx == 0) kernel.setArg(arg + 2, noCache);
+  if (params.ms_cache.nx == 0) kernel.setArg(arg + 3, noCache);
   rt.queue.finish();
   st.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -102,8 +106,14 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
       lightCache.update(rt, dev, params, scene.sourcePath);
       kernel.setArg(arg + 2, lightCache.buffer());
     }
+    if (params.ms_cache.nx > 0) {  // likewise: built to its paths before the first frame, then kept
+      const MsCacheSettings& mc = scene.renderer.raymarch.msCache;
+      msCache.refine(rt, dev, params, mc.paths, mc.pathsPerLaunch, scene.sourcePath);
+      kernel.setArg(arg + 3, msCache.buffer());
+    }
     const auto tf = std::chrono::steady_clock::now();
-    const cl::Event ev = launchAndWait(rt, kernel, global, local, algorithm, deviceBytes + lightCache.bytes());
+    const cl::Event ev =
+        launchAndWait(rt, kernel, global, local, algorithm, deviceBytes + lightCache.bytes() + msCache.bytes());
     wallMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tf).count());
     kernelMs.push_back(eventSeconds(ev) * 1e3);
     if (options.progress) options.progress(f + 1, requested);
@@ -124,6 +134,13 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   st.lightCacheCells[0] = std::max(0, params.light_cache.nx - 1);
   st.lightCacheCells[1] = std::max(0, params.light_cache.ny - 1);
   st.lightCacheCells[2] = std::max(0, params.light_cache.nz - 1);
+  st.status |= msCache.status();
+  st.msCacheMs = msCache.buildMs();
+  st.msCachePaths = msCache.paths();
+  st.msCacheBuilds = msCache.rebuilds();
+  st.msCacheCells[0] = std::max(0, params.ms_cache.nx - 1);
+  st.msCacheCells[1] = std::max(0, params.ms_cache.ny - 1);
+  st.msCacheCells[2] = std::max(0, params.ms_cache.nz - 1);
   st.frames = frameTimings(kernelMs, wallMs);
   for (double ms : kernelMs) st.kernelSeconds += ms * 1e-3;
   for (double ms : wallMs) st.seconds += ms * 1e-3;

@@ -91,6 +91,11 @@ struct RenderStats {
   size_t lightCacheBytes = 0;
   int lightCacheBuilds = 0;
   double lightCacheMs = 0;
+  // raymarch with multipleScattering "cache" (render/ms_cache.h): cells per axis (0 0 0: off),
+  // paths per node, times it was started (1), its build time apart from the frames.
+  int msCacheCells[3] = {0, 0, 0};
+  int msCachePaths = 0, msCacheBuilds = 0;
+  double msCacheMs = 0;
 };
 
 struct RenderResult {

@@ -69,6 +69,16 @@ enum class ToneMapping { None, Reinhard, Aces };
 // warning, when that choice cannot hold the grid. render/device_grid.h resolves it.
 enum class GridStorage { Auto, Image, Buffer, Bricks };
 
+// What the ray marcher adds for light scattered more than once: nothing, Wrenninge's octaves, or
+// the path-traced multiple-scattering cache (kernels/shared/ms_cache.h).
+enum class MultipleScattering { None, Octaves, Cache };
+
+struct MsCacheSettings {
+  int resolution = 16;      // cells on the medium box's longest axis
+  int paths = 256;          // paths per node
+  int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
+};
+
 struct RaymarchSettings {
   int steps = 60;
   int shadowSteps = 10;
@@ -81,6 +91,9 @@ struct RaymarchSettings {
   // Early termination of the view march: it stops once every channel's transmittance is below
   // this (kernels/shared/raymarch.h derives the error bound); 0 marches to the end.
   float minTransmittance = 1e-3f;
+  // Absent from the scene: Octaves when octaves > 1, else None (scenes from before the key).
+  MultipleScattering multipleScattering = MultipleScattering::None;
+  MsCacheSettings msCache;
 };
 
 struct LobeSettings {

@@ -55,6 +55,9 @@
 // |   raymarch.octaves      | integer                         |     | 1           | [1, 16]; 1 = off           |
 // |   raymarch.octaveScattering, .octaveExtinction, .octavePhase (a, b, c) | number | | 0.5 | [0, 1], a <= b   |
 // |   raymarch.minTransmittance | number: view march stops   |     | 0.001       | [0, 1); 0 = never          |
+// |   raymarch.multipleScattering | none, octaves, cache      |     | none        | octaves when octaves > 1   |
+// |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]                   |
+// |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
 // |   lobe.depthFactor      | number                          |     | 20          | >= 0                       |
 // |   lobe.lobePoints       | integer                         |     | 30          | >= 1                       |
 // |   lobe.lobeRadius       | number, world units             |     | 1           | >= 0                       |
@@ -136,6 +139,9 @@ const EnumNames<GridStorage> kGridStorages = {{"auto", GridStorage::Auto},
                                               {"image", GridStorage::Image},
                                               {"buffer", GridStorage::Buffer},
                                               {"bricks", GridStorage::Bricks}};
+const EnumNames<MultipleScattering> kMultipleScattering = {{"none", MultipleScattering::None},
+                                                           {"octaves", MultipleScattering::Octaves},
+                                                           {"cache", MultipleScattering::Cache}};
 const EnumNames<std::string> kAlgorithms = {{"pathtrace", "pathtrace"},
                                             {"raymarch", "raymarch"},
                                             {"lobe", "lobe"}};
@@ -332,6 +338,18 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
                                                 formatNumber(s.raymarch.octaveExtinction) +
                                                 ") or the octaves add energy");
     s.raymarch.minTransmittance = readMinTransmittance(m, s.raymarch.minTransmittance);
+    s.raymarch.multipleScattering =
+        readEnum(m, "multipleScattering", kMultipleScattering,
+                 s.raymarch.octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::None);
+    if (s.raymarch.octaves > 1 && s.raymarch.multipleScattering != MultipleScattering::Octaves)
+      ctx.fail(m.keyOf("octaves"), "applies only with multipleScattering \"octaves\"");
+    if (const json* c = m.find("msCache")) {
+      ObjectReader mc(ctx, *c, m.keyOf("msCache"));
+      s.raymarch.msCache.resolution = readInt(mc, "resolution", s.raymarch.msCache.resolution, 1, 256);
+      s.raymarch.msCache.paths = readInt(mc, "paths", s.raymarch.msCache.paths, 1, 1 << 20);
+      s.raymarch.msCache.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.raymarch.msCache.pathsPerLaunch, 1, 1 << 20);
+      mc.reportUnknown();
+    }
     m.reportUnknown();
   }
   if (const json* v = r.find("lobe")) {

@@ -66,6 +66,7 @@
 
 #include "shared/camera.h"
 #include "shared/light_cache.h"
+#include "shared/ms_cache.h"
 #include "shared/phase.h"
 
 /* Below this optical depth per step, (1 − e^{−x})/x is evaluated by its Taylor series: the direct
@@ -125,9 +126,9 @@ typedef struct raymarch_accum {
  * the scene's own parameters, no cap of their own. */
 static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                     GRID_PARAM, NV_CONSTANT const realtime_params* rp,
-                                    NV_GLOBAL const float* light_cache, NV_PRIVATE const medium_segment* seg,
-                                    vec3 origin, vec3 dir, int steps, float t_stop, NV_PRIVATE raymarch_accum* acc,
-                                    NV_PRIVATE uint* status) {
+                                    NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache,
+                                    NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, int steps,
+                                    float t_stop, NV_PRIVATE raymarch_accum* acc, NV_PRIVATE uint* status) {
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
   march_iter it = march_begin(m, GRID_ARG, seg, steps);
@@ -142,9 +143,12 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
     const vec3 sigma_t = vec3_scale(vec3_add(sa, ss), rho); /* as march_sigma_t */
     const vec3 sigma_s = vec3_scale(ss, rho);
     vec3 S = vec3_splat(0.0f);
-    if (!vec3_is_zero(sigma_s))
-      S = vec3_mul(sigma_s, raymarch_light_sum(s, lights, GRID_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir,
-                                               status));
+    if (!vec3_is_zero(sigma_s)) {
+      vec3 Li = raymarch_light_sum(s, lights, GRID_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir, status);
+      if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h) */
+        Li = vec3_add(Li, ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), vec3_madd(seg->o, seg->d, t)));
+      S = vec3_mul(sigma_s, Li);
+    }
     const vec3 x = vec3_scale(sigma_t, dt);
     const vec3 e = vec3_exp_neg(x);
     const vec3 w = vec3_make(raymarch_step_weight(x.x, e.x), raymarch_step_weight(x.y, e.y),
@@ -159,7 +163,8 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
 /* Radiance through the centre of pixel (px, py). Pinhole: the ray leaves the lens centre. */
 static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                   GRID_PARAM, NV_CONSTANT const realtime_params* rp,
-                                  NV_GLOBAL const float* light_cache, int px, int py, NV_PRIVATE uint* status) {
+                                  NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache, int px, int py,
+                                  NV_PRIVATE uint* status) {
   const ray3 r = camera_ray(&s->camera, (float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f);
   const vec3 Lb = march_background(s, lights, r.origin, r.dir);
   vec3 L = Lb;
@@ -174,7 +179,8 @@ static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT
       acc.L = vec3_splat(0.0f);
       acc.T = vec3_splat(1.0f);
       const float t_stop = rp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb));
-      raymarch_segment(s, lights, GRID_ARG, rp, light_cache, &seg, r.origin, r.dir, rp->steps, t_stop, &acc, status);
+      raymarch_segment(s, lights, GRID_ARG, rp, light_cache, ms_cache, &seg, r.origin, r.dir, rp->steps, t_stop, &acc,
+                       status);
       L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
     }
   }

@@ -101,6 +101,7 @@ typedef struct realtime_params {
   float min_transmittance; /* view marches stop once every channel's transmittance is below it; 0: never */
   int pad0;
   node_grid_params light_cache; /* the light-transmittance cache (light_cache.h); nx = 0: off */
+  node_grid_params ms_cache;    /* raymarch: the multiple-scattering cache (ms_cache.h); nx = 0: off */
 } realtime_params;
 
 typedef struct scene_params {

@@ -335,6 +335,7 @@ const char* kCloudScene = R"({
 Scene cloudScene(int octaves, float a, float b, float c) {
   Scene s = sceneFromJson(kCloudScene);
   s.renderer.raymarch.octaves = octaves;
+  s.renderer.raymarch.multipleScattering = octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::None;
   s.renderer.raymarch.octaveScattering = a;
   s.renderer.raymarch.octaveExtinction = b;
   s.renderer.raymarch.octavePhase = c;
@@ -400,6 +401,7 @@ TEST(RenderRaymarch, OctavesMatchQuadrature) {
   const double a = 0.5, b = 0.6, c = 0.4;
   Scene scene = slabScene(512, 64);
   scene.renderer.raymarch.octaves = N;
+  scene.renderer.raymarch.multipleScattering = MultipleScattering::Octaves;
   scene.renderer.raymarch.octaveScattering = float(a);
   scene.renderer.raymarch.octaveExtinction = float(b);
   scene.renderer.raymarch.octavePhase = float(c);

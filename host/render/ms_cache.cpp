@@ -1,0 +1,71 @@
+#include "render/ms_cache.h"
+
+#include <algorithm>
+
+#include "render/device_allocation.h"
+#include "render/node_grid.h"
+#include "render/render_common.h"
+
+namespace narval {
+
+namespace {
+
+template <typename T>
+std::string bytesOf(const T& v) {
+  return std::string(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+}  // namespace
+
+void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params,
+                           int targetPaths, int pathsPerLaunch, const std::string& sceneFile) {
+  const node_grid_params& c = params.ms_cache;
+  if (c.nx <= 0) throw std::invalid_argument("DeviceMsCache::refine: the cache is off (nx = 0)");
+  const size_t nodes = nodeGridCount(c);
+  // The paths see the whole scene but the camera: medium, grid, lights, bounces, seed, background.
+  scene_params pathScene = dev.scene.params;
+  pathScene.camera = camera_params{};
+  pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
+  std::string key = bytesOf(pathScene) + bytesOf(dev.scene.grid) + bytesOf(c) + dev.scene.buildOptions;
+  for (int l = 0; l < pathScene.num_lights; ++l) key += bytesOf(dev.scene.lights[size_t(l)]);
+  if (key != key_) {
+    bytes_ = nodes * 4 * sizeof(float);
+    const AllocationSite site{sceneFile, "renderer.raymarch.msCache.resolution",
+                              "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
+                                  "x" + std::to_string(c.nz) + " nodes"};
+    buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site);
+    rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
+    program_ = buildProgram(rt, "ms_cache.cl", dev.scene.buildOptions);
+    kernel_ = cl::Kernel(program_, "ms_cache_build");
+    sceneBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof pathScene, &pathScene);
+    statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
+    rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
+    paths_ = 0;
+    ++rebuilds_;
+    key_ = key;
+  }
+  if (paths_ >= targetPaths) return;
+  paramBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(params),
+                         const_cast<realtime_params*>(&params));
+  dev.bind(kernel_);
+  kernel_.setArg(0, sceneBuf_);
+  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
+  kernel_.setArg(arg + 0, paramBuf_);
+  kernel_.setArg(arg + 3, buffer_);
+  kernel_.setArg(arg + 4, statusBuf_);
+  const size_t local = 64, global = (nodes + local - 1) / local * local;
+  while (paths_ < targetPaths) {
+    const int count = std::min(std::max(1, pathsPerLaunch), targetPaths - paths_);
+    kernel_.setArg(arg + 1, cl_uint(paths_));
+    kernel_.setArg(arg + 2, cl_uint(count));
+    const cl::Event ev = launchAndWait(rt, kernel_, cl::NDRange(global), cl::NDRange(local),
+                                       "the multiple-scattering cache", deviceSceneBytes(dev.scene) + bytes_);
+    buildMs_ += eventSeconds(ev) * 1e3;
+    paths_ += count;
+  }
+  cl_uint st = 0;
+  rt.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof st, &st);
+  status_ |= st;
+}
+
+}  // namespace narval

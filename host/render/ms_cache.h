@@ -1,0 +1,42 @@
+// ms_cache.h: the ray marcher's multiple-scattering cache on the device (kernels/shared/ms_cache.h
+// holds the math; kernels/ms_cache.cl adds paths to it). Per node of a grid over the medium's box,
+// the running mean of paths started there by the path tracer's own code. Progressive: refine()
+// adds a number of paths per node (a viewer can call it once per frame); it starts over only when
+// what the paths depend on changes (medium, grid, lights, bounces, seed, background, layout).
+#pragma once
+
+#include <string>
+
+#include "cl/cl_runtime.h"
+#include "render/device_scene.h"
+#include "shared/structs.h"
+
+namespace narval {
+
+class DeviceMsCache {
+ public:
+  // Brings the cache to at least `targetPaths` paths per node for the scene on `dev` and
+  // params.ms_cache (nx > 0), in launches of at most `pathsPerLaunch` paths per node; starts over
+  // when the scene changed. Throws InputError when the cache exceeds the device's largest
+  // allocation (naming `sceneFile` and renderer.raymarch.msCache.resolution).
+  void refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params, int targetPaths,
+              int pathsPerLaunch, const std::string& sceneFile);
+  const cl::Buffer& buffer() const { return buffer_; }
+  int paths() const { return paths_; }             // paths per node so far
+  int rebuilds() const { return rebuilds_; }       // times it started over (1 for one scene)
+  double buildMs() const { return buildMs_; }      // launch time by profiling events, all launches
+  size_t bytes() const { return bytes_; }
+  uint32_t status() const { return status_; }
+
+ private:
+  std::string key_;
+  cl::Program program_;
+  cl::Kernel kernel_;
+  cl::Buffer buffer_, sceneBuf_, paramBuf_, statusBuf_;
+  int paths_ = 0, rebuilds_ = 0;
+  double buildMs_ = 0;
+  size_t bytes_ = 0;
+  uint32_t status_ = 0;
+};
+
+}  // namespace narval

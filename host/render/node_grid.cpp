@@ -1,0 +1,30 @@
+#include "render/node_grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace narval {
+
+node_grid_params nodeGridLayout(const DeviceScene& ds, int cells) {
+  node_grid_params c{};
+  const scene_params& sp = ds.params;
+  if (cells <= 0 || !sp.has_medium) return c;
+  const medium_params& m = sp.medium;
+  c.index_to_world = affineInverse(m.world_to_index);
+  // World length of each box edge: the index-to-world map's column times the box's index extent.
+  const float dims[3] = {m.dims.x, m.dims.y, m.dims.z};
+  float len[3];
+  for (int a = 0; a < 3; ++a) {
+    const float col[3] = {(&c.index_to_world.row[0].x)[a], (&c.index_to_world.row[1].x)[a],
+                          (&c.index_to_world.row[2].x)[a]};
+    len[a] = dims[a] * std::sqrt(col[0] * col[0] + col[1] * col[1] + col[2] * col[2]);
+  }
+  const float longest = std::max({len[0], len[1], len[2]});
+  int* nodes[3] = {&c.nx, &c.ny, &c.nz};
+  for (int a = 0; a < 3; ++a) *nodes[a] = 1 + std::max(1, int(std::lround(double(cells) * len[a] / longest)));
+  return c;
+}
+
+size_t nodeGridCount(const node_grid_params& c) { return size_t(c.nx) * size_t(c.ny) * size_t(c.nz); }
+
+}  // namespace narval

@@ -1,0 +1,43 @@
+/* ms_cache_build.h: estimating the multiple-scattering cache (ms_cache.h) with the path tracer's
+ * own code; kept apart from the lookup so the ray marcher does not compile the path tracer. */
+#ifndef NARVAL_MS_CACHE_BUILD_H
+#define NARVAL_MS_CACHE_BUILD_H
+
+#include "shared/ms_cache.h"
+#include "shared/pathtrace.h"
+#include "shared/sampling.h"
+
+/* The stream the cache's paths draw from: the scene's seed offset, so that node n's paths never
+ * share the numbers of pixel n's camera samples. */
+#define MS_CACHE_SEED_OFFSET 0x6d73u
+
+/* Path k's estimate of R at node `node`: the radiance of the rest arriving from a uniform direction. */
+static inline vec3 ms_cache_path(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights, GRID_PARAM,
+                                 NV_CONSTANT const node_grid_params* c, int node, uint k, NV_PRIVATE uint* status) {
+  const vec3 x = affine_point(c->index_to_world, node_grid_point(c, vec3_from4(s->medium.dims), node));
+  rng_state rng = rng_init(s->seed + MS_CACHE_SEED_OFFSET, (uint)node, k);
+  const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
+  const vec3 L = pathtrace_radiance(s, lights, GRID_ARG, x, sample_uniform_sphere(u1, u2), 0, &rng, status);
+  if (!vec3_is_finite(L)) {
+    *status |= STATUS_NAN;
+    return vec3_splat(0.0f);
+  }
+  return L;
+}
+
+/* Adds paths [first, first + count) to node `node`'s running mean (xyz) and count (w). */
+static inline nv_float4 ms_cache_refine_node(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                             GRID_PARAM, NV_CONSTANT const node_grid_params* c, int node, nv_float4 acc,
+                                             uint first, uint count, NV_PRIVATE uint* status) {
+  for (uint k = first; k < first + count; ++k) {
+    const vec3 L = ms_cache_path(s, lights, GRID_ARG, c, node, k, status);
+    const float n = (float)(k + 1u);
+    acc.x += (L.x - acc.x) / n;
+    acc.y += (L.y - acc.y) / n;
+    acc.z += (L.z - acc.z) / n;
+    acc.w = n;
+  }
+  return acc;
+}
+
+#endif
