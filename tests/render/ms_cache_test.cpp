@@ -1,0 +1,142 @@
+// The ray marcher's multiple-scattering cache (kernels/shared/ms_cache.h, render/ms_cache.h):
+// the white furnace, where ray marching plus the cache is exact, and the cache's convergence and
+// determinism as it is refined.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "render/device_scene.h"
+#include "render/ms_cache.h"
+#include "render/node_grid.h"
+#include "render/realtime_renderer.h"
+#include "render_fixture.h"
+#include "test_support.h"
+#include "volume/grid.h"
+
+namespace narval::test {
+namespace {
+
+// A white furnace: the unit cube of a purely scattering medium (albedo 1, isotropic), no lights,
+// background radiance 1. The radiance is 1 everywhere and in every direction.
+std::string furnaceJson(const std::string& multipleScattering, double density = 1) {
+  return R"({
+    "materials": [
+      {"name": "white", "type": "volume", "scattering": [1, 1, 1], "absorption": [0, 0, 0], "density": )" +
+         std::to_string(density) + R"(}
+    ],
+    "primitives": [{"name": "box", "type": "volume", "transform": {"scale": [1, 1, 1]}, "materialName": "white"}],
+    "camera": {"position": [0, 0, -3], "lookAt": [0, 0, 0], "vfov": 30},
+    "renderer": {"resolution": [16, 16], "algorithm": "raymarch", "bounces": 1000, "storage": "buffer",
+                 "raymarch": {"steps": 40, "minTransmittance": 0, "multipleScattering": ")" + multipleScattering +
+         R"(", "msCache": {"resolution": 4, "paths": 8, "pathsPerLaunch": 4}}},
+    "background": [1, 1, 1]
+  })";
+}
+
+// In the furnace every cache path escapes to the background (a thousand bounces are never reached
+// in a box of optical depth ≤ 1.7 per unit of density here: the chance is below 1e-300) with
+// throughput exactly 1 (albedo 1, analogue tracking), so every node's mean is exactly 1. The march
+// then adds Σ_k T_k·(σs·1/σt)·(1 − e^{−σt·Δ}) + T_end·1 = Σ_k T_k(1 − e_k) + T_end = 1: a sum that
+// telescopes, off by float rounding only (the step weight's series within 1.4e-8 relative, ~40
+// steps of a few ulps): |L − 1| ≤ 1e-5. Without the cache the march keeps only T_end·1: the
+// centre pixel's ray crosses a unit of density 1 (σt = 1), so it reads e^{−1} = 0.368.
+TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
+  const DenseGrid cloud = makeCloud(24, 5);
+  for (const DenseGrid* grid : {static_cast<const DenseGrid*>(nullptr), &cloud}) {
+    SCOPED_TRACE(grid ? "generated cloud" : "homogeneous");
+    const double density = grid ? 3 : 1;
+    const RenderResult cached = renderRealtime(runtime(), sceneFromJson(furnaceJson("cache", density)), grid, 3, {});
+    ASSERT_EQ(cached.stats.status, 0u);
+    EXPECT_EQ(cached.stats.msCachePaths, 8);
+    EXPECT_EQ(cached.stats.msCacheBuilds, 1);  // built once for three frames
+    EXPECT_EQ(cached.stats.msCacheCells[0], 4);
+    double worst = 0;
+    for (float v : cached.image.rgb) worst = std::max(worst, std::fabs(v - 1.0));
+    std::printf("[ ms cache ] furnace (%s): max |L - 1| %.2g with the cache\n", grid ? "cloud" : "box", worst);
+    EXPECT_LE(worst, 1e-5);
+
+    const RenderResult none = renderRealtime(runtime(), sceneFromJson(furnaceJson("none", density)), grid, 1, {});
+    double darkest = 1;
+    for (float v : none.image.rgb) darkest = std::min(darkest, double(v));
+    std::printf("[ ms cache ] furnace (%s): darkest value %.4f without it\n", grid ? "cloud" : "box", darkest);
+    EXPECT_LT(darkest, 0.9);
+    if (!grid) {
+      const float* centre = none.image.pixel(8, 8);  // its ray passes within half a pixel of the axis
+      EXPECT_NEAR(centre[0], std::exp(-1.0), 2e-3);
+    }
+  }
+}
+
+// A lit isotropic box (a point light above it, background 0.2): the cache's nodes after K paths.
+Scene litBox() {
+  return sceneFromJson(R"({
+    "materials": [
+      {"name": "bulb", "type": "emitter", "albedo": [5, 5, 5]},
+      {"name": "fog", "type": "volume", "scattering": [1.5, 1.5, 1.5], "absorption": [0.5, 0.5, 0.5], "density": 1}
+    ],
+    "primitives": [
+      {"name": "point", "type": "point", "transform": {"position": [0, 0, 3]}, "materialName": "bulb"},
+      {"name": "box", "type": "volume", "transform": {"scale": [1, 1, 1]}, "materialName": "fog"}
+    ],
+    "camera": {"position": [0, 0, -4], "lookAt": [0, 0, 0], "vfov": 30},
+    "renderer": {"resolution": [8, 8], "algorithm": "raymarch", "bounces": 20,
+                 "raymarch": {"multipleScattering": "cache", "msCache": {"resolution": 4}}},
+    "background": [0.2, 0.2, 0.2]
+  })");
+}
+
+std::vector<float> cacheAfter(const Scene& scene, int paths, int perLaunch) {
+  DeviceSceneBuffers dev(runtime(), scene, nullptr);
+  const realtime_params params = realtimeParams(scene, dev.scene);
+  DeviceMsCache cache;
+  cache.refine(runtime(), dev, params, paths, perLaunch, "lit_box.json");
+  EXPECT_EQ(cache.status(), 0u);
+  std::vector<float> v(nodeGridCount(params.ms_cache) * 4);
+  runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, v.size() * sizeof(float), v.data());
+  return v;
+}
+
+// Path k of node n draws from its own stream and the running mean adds paths in index order, so
+// the cache after K paths does not depend on how the launches split them: bit for bit.
+TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
+  const Scene scene = litBox();
+  const std::vector<float> one = cacheAfter(scene, 48, 48), many = cacheAfter(scene, 48, 5);
+  EXPECT_EQ(one, many);
+  for (size_t i = 3; i < one.size(); i += 4) ASSERT_EQ(one[i], 48.0f);  // w: the count
+}
+
+// Convergence: node n's mean of K paths, m_K, against N = 8192 paths of the same streams (its first
+// K paths included): Var(m_K − m_N) = σ²(1/K − 1/N), so the RMS error over nodes and channels
+// falls as K^(−1/2)·sqrt(1 − K/N). Fitted over K = 16, 64, 256 (after dividing out that factor),
+// the log-log slope must be −0.5 within ±0.12: with 125 nodes × 3 channels (channels grey here,
+// so 125 independent nodes) each RMS is known to ~±6% (1/sqrt(2·125)), the slope over a 16x
+// range of K to ±0.06 (one σ), so ±0.12 is two σ.
+TEST(MsCache, ErrorFallsAsOneOverTheSquareRootOfThePaths) {
+  const Scene scene = litBox();
+  const int N = 8192;
+  const std::vector<float> ref = cacheAfter(scene, N, 1024);
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const int ks[] = {16, 64, 256};
+  for (int K : ks) {
+    const std::vector<float> c = cacheAfter(scene, K, K);
+    double se = 0;
+    int n = 0;
+    for (size_t i = 0; i < c.size(); i += 4) {
+      const double d = double(c[i]) - ref[i];
+      se += d * d;
+      ++n;
+    }
+    const double rms = std::sqrt(se / n) / std::sqrt(1.0 - double(K) / N);
+    std::printf("[ ms cache ] %4d paths: RMS error %.4g\n", K, rms);
+    const double x = std::log(double(K)), y = std::log(rms);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double m = 3, slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
+  std::printf("[ ms cache ] fitted slope %.3f (expected -0.5)\n", slope);
+  EXPECT_NEAR(slope, -0.5, 0.12);
+}
+
+}  // namespace
+}  // namespace narval::test
