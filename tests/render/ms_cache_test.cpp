@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <vector>
 
 #include "render/device_scene.h"
@@ -44,8 +45,17 @@ std::string furnaceJson(const std::string& multipleScattering, double density = 
 // centre pixel's ray crosses a unit of density 1 (σt = 1), so it reads e^{−1} = 0.368.
 TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
   const DenseGrid cloud = makeCloud(24, 5);
-  for (const DenseGrid* grid : {static_cast<const DenseGrid*>(nullptr), &cloud}) {
-    SCOPED_TRACE(grid ? "generated cloud" : "homogeneous");
+  // The real Disney cloud when the shared data is there (NARVAL_DATA_DIR or ../shared/data/volumes).
+  const std::string disneyPath = realDataPath("wdas_cloud_sixteenth.vdb");
+  DenseGrid disney;
+  if (std::filesystem::exists(disneyPath))
+    disney = loadGrid(disneyPath);
+  else
+    std::printf("[ ms cache ] furnace on the Disney cloud skipped: %s absent\n", disneyPath.c_str());
+  for (const DenseGrid* grid : {static_cast<const DenseGrid*>(nullptr), static_cast<const DenseGrid*>(&cloud),
+                                static_cast<const DenseGrid*>(&disney)}) {
+    if (grid == &disney && disney.data.empty()) continue;
+    SCOPED_TRACE(grid ? grid->source + " grid" : "homogeneous");
     const double density = grid ? 3 : 1;
     const RenderResult cached = renderRealtime(runtime(), sceneFromJson(furnaceJson("cache", density)), grid, 3, {});
     ASSERT_EQ(cached.stats.status, 0u);
@@ -54,13 +64,14 @@ TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
     EXPECT_EQ(cached.stats.msCacheCells[0], 4);
     double worst = 0;
     for (float v : cached.image.rgb) worst = std::max(worst, std::fabs(v - 1.0));
-    std::printf("[ ms cache ] furnace (%s): max |L - 1| %.2g with the cache\n", grid ? "cloud" : "box", worst);
+    const char* name = !grid ? "box" : grid == &cloud ? "generated cloud" : "Disney cloud";
+    std::printf("[ ms cache ] furnace (%s): max |L - 1| %.2g with the cache\n", name, worst);
     EXPECT_LE(worst, 1e-5);
 
     const RenderResult none = renderRealtime(runtime(), sceneFromJson(furnaceJson("none", density)), grid, 1, {});
     double darkest = 1;
     for (float v : none.image.rgb) darkest = std::min(darkest, double(v));
-    std::printf("[ ms cache ] furnace (%s): darkest value %.4f without it\n", grid ? "cloud" : "box", darkest);
+    std::printf("[ ms cache ] furnace (%s): darkest value %.4f without it\n", name, darkest);
     EXPECT_LT(darkest, 0.9);
     if (!grid) {
       const float* centre = none.image.pixel(8, 8);  // its ray passes within half a pixel of the axis
@@ -105,6 +116,31 @@ TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
   const std::vector<float> one = cacheAfter(scene, 48, 48), many = cacheAfter(scene, 48, 5);
   EXPECT_EQ(one, many);
   for (size_t i = 3; i < one.size(); i += 4) ASSERT_EQ(one[i], 48.0f);  // w: the count
+}
+
+// Kept across frames and camera moves, started over when the medium or a light changes: refine()
+// to the same count builds nothing; another camera keeps the paths; a moved light starts over.
+TEST(MsCache, StartsOverOnlyWhenWhatThePathsSeeChanges) {
+  const Scene scene = litBox();
+  DeviceMsCache cache;
+  DeviceSceneBuffers dev(runtime(), scene, nullptr);
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
+  EXPECT_EQ(cache.rebuilds(), 1);
+  EXPECT_EQ(cache.paths(), 8);
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 12, 8, "a");  // progressive: 4 more
+  EXPECT_EQ(cache.paths(), 12);
+  Scene camera = scene;
+  camera.camera.position = {1, 1, -4};
+  DeviceSceneBuffers devCamera(runtime(), camera, nullptr);
+  cache.refine(runtime(), devCamera, realtimeParams(camera, devCamera.scene), 12, 8, "camera");
+  EXPECT_EQ(cache.rebuilds(), 1);
+  Scene moved = scene;
+  moved.primitives[0].transform.position = {0.5f, 0, 3};
+  DeviceSceneBuffers devMoved(runtime(), moved, nullptr);
+  cache.refine(runtime(), devMoved, realtimeParams(moved, devMoved.scene), 12, 8, "moved");
+  EXPECT_EQ(cache.rebuilds(), 2);
+  EXPECT_EQ(cache.paths(), 12);
 }
 
 // Convergence: node n's mean of K paths, m_K, against N = 8192 paths of the same streams (its first
