@@ -32,15 +32,6 @@ std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view*
   return cache;
 }
 
-namespace {
-
-template <typename T>
-std::string bytesOf(const T& v) {
-  return std::string(reinterpret_cast<const char*>(&v), sizeof v);
-}
-
-}  // namespace
-
 void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params,
                               const std::string& sceneFile) {
   const node_grid_params& c = params.light_cache;
@@ -49,8 +40,8 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   const size_t nodes = size_t(c.nx) * size_t(c.ny) * size_t(c.nz);
   // Everything a slab depends on besides its light. The grid is identified by its address: a
   // DeviceSceneBuffers keeps its grid for its life, and a new scene makes a new one.
-  const std::string key = bytesOf(dev.scene.params.medium) + bytesOf(dev.scene.grid) + bytesOf(c) +
-                          bytesOf(params.shadow_steps) + dev.scene.buildOptions + bytesOf(numLights);
+  const std::string key = rawBytes(dev.scene.params.medium) + rawBytes(dev.scene.grid) + rawBytes(c) +
+                          rawBytes(params.shadow_steps) + dev.scene.buildOptions + rawBytes(numLights);
   const bool all = key != mediumKey_;
   if (all) {
     bytes_ = std::max<size_t>(1, nodes * size_t(numLights)) * sizeof(float);

@@ -8,15 +8,6 @@
 
 namespace narval {
 
-namespace {
-
-template <typename T>
-std::string bytesOf(const T& v) {
-  return std::string(reinterpret_cast<const char*>(&v), sizeof v);
-}
-
-}  // namespace
-
 void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params,
                            int targetPaths, int pathsPerLaunch, const std::string& sceneFile) {
   const node_grid_params& c = params.ms_cache;
@@ -26,8 +17,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   scene_params pathScene = dev.scene.params;
   pathScene.camera = camera_params{};
   pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
-  std::string key = bytesOf(pathScene) + bytesOf(dev.scene.grid) + bytesOf(c) + dev.scene.buildOptions;
-  for (int l = 0; l < pathScene.num_lights; ++l) key += bytesOf(dev.scene.lights[size_t(l)]);
+  std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.scene.buildOptions;
+  for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
     bytes_ = nodes * 4 * sizeof(float);
     const AllocationSite site{sceneFile, "renderer.raymarch.msCache.resolution",

@@ -44,6 +44,13 @@ cl::Event launchAndWait(ClRuntime& rt, const cl::Kernel& kernel, const cl::NDRan
 // One warning line per STATUS_* bit set in `status` (what the kernels met; DESIGN.md).
 std::vector<std::string> statusWarnings(uint32_t status);
 
+// The bytes of a plain struct, as a string: a key for "has this input changed" (the real-time
+// caches compare what they were built from).
+template <typename T>
+std::string rawBytes(const T& v) {
+  return std::string(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
 // True once options.cancel is set (Ctrl-C): the render loops stop before their next pass.
 bool cancelled(const RenderOptions& options);
 
