@@ -27,4 +27,10 @@ node_grid_params nodeGridLayout(const DeviceScene& ds, int cells) {
 
 size_t nodeGridCount(const node_grid_params& c) { return size_t(c.nx) * size_t(c.ny) * size_t(c.nz); }
 
+void nodeGridCells(const node_grid_params& c, int cells[3]) {
+  cells[0] = std::max(0, c.nx - 1);
+  cells[1] = std::max(0, c.ny - 1);
+  cells[2] = std::max(0, c.nz - 1);
+}
+
 }  // namespace narval

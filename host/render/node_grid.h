@@ -14,4 +14,7 @@ node_grid_params nodeGridLayout(const DeviceScene& ds, int cells);
 // Nodes of the layout (0 when off).
 size_t nodeGridCount(const node_grid_params& c);
 
+// Cells per axis (nodes − 1; 0 0 0 when off), as the stats report them.
+void nodeGridCells(const node_grid_params& c, int cells[3]);
+
 }  // namespace narval

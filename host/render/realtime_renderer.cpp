@@ -131,16 +131,12 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   st.lightCacheMs = lightCache.buildMs();
   st.lightCacheBuilds = lightCache.slabsBuilt();
   st.lightCacheBytes = lightCache.bytes();
-  st.lightCacheCells[0] = std::max(0, params.light_cache.nx - 1);
-  st.lightCacheCells[1] = std::max(0, params.light_cache.ny - 1);
-  st.lightCacheCells[2] = std::max(0, params.light_cache.nz - 1);
+  nodeGridCells(params.light_cache, st.lightCacheCells);
   st.status |= msCache.status();
   st.msCacheMs = msCache.buildMs();
   st.msCachePaths = msCache.paths();
   st.msCacheBuilds = msCache.rebuilds();
-  st.msCacheCells[0] = std::max(0, params.ms_cache.nx - 1);
-  st.msCacheCells[1] = std::max(0, params.ms_cache.ny - 1);
-  st.msCacheCells[2] = std::max(0, params.ms_cache.nz - 1);
+  nodeGridCells(params.ms_cache, st.msCacheCells);
   st.frames = frameTimings(kernelMs, wallMs);
   for (double ms : kernelMs) st.kernelSeconds += ms * 1e-3;
   for (double ms : wallMs) st.seconds += ms * 1e-3;
