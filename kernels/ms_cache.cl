@@ -4,19 +4,13 @@
 #include "shared/ms_cache_build.h"
 
 __kernel void ms_cache_build(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
-                             __constant realtime_params* params, uint first, uint count, __global float4* cache,
+                             __constant realtime_params* params, uint first, uint count, __global float* cache,
                              __global uint* status_word) {
   const int node = get_global_id(0);
   __constant node_grid_params* c = &params->ms_cache;
   if (node >= node_grid_count(c)) return;
   uint status = 0u;
-  const float4 a = cache[node];
-  nv_float4 in;
-  in.x = a.x;
-  in.y = a.y;
-  in.z = a.z;
-  in.w = a.w;
-  const nv_float4 acc = ms_cache_refine_node(scene, lights, GRID_ARG, c, node, in, first, count, &status);
-  cache[node] = (float4)(acc.x, acc.y, acc.z, acc.w);
+  ms_cache_refine_node(scene, lights, GRID_ARG, c, node, cache + (size_t)node * MS_CACHE_STRIDE, first, count,
+                       &status);
   if (status) atomic_or(status_word, status);
 }

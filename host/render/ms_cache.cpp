@@ -5,6 +5,7 @@
 #include "render/device_allocation.h"
 #include "render/node_grid.h"
 #include "render/render_common.h"
+#include "shared/ms_cache.h"
 
 namespace narval {
 
@@ -20,7 +21,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.scene.buildOptions;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
-    bytes_ = nodes * 4 * sizeof(float);
+    bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
     const AllocationSite site{sceneFile, "renderer.raymarch.msCache.resolution",
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
                                   "x" + std::to_string(c.nz) + " nodes"};

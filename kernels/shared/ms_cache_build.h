@@ -11,13 +11,16 @@
  * share the numbers of pixel n's camera samples. */
 #define MS_CACHE_SEED_OFFSET 0x6d73u
 
-/* Path k's estimate of R at node `node`: the radiance of the rest arriving from a uniform direction. */
+/* Path k's estimate at node `node`: the radiance of the rest arriving from a uniform direction,
+ * and the direction ω it looked along. */
 static inline vec3 ms_cache_path(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights, GRID_PARAM,
-                                 NV_CONSTANT const node_grid_params* c, int node, uint k, NV_PRIVATE uint* status) {
+                                 NV_CONSTANT const node_grid_params* c, int node, uint k, NV_PRIVATE vec3* omega,
+                                 NV_PRIVATE uint* status) {
   const vec3 x = affine_point(c->index_to_world, node_grid_point(c, vec3_from4(s->medium.dims), node));
   rng_state rng = rng_init(s->seed + MS_CACHE_SEED_OFFSET, (uint)node, k);
   const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
-  const vec3 L = pathtrace_radiance(s, lights, GRID_ARG, x, sample_uniform_sphere(u1, u2), 0, &rng, status);
+  *omega = sample_uniform_sphere(u1, u2);
+  const vec3 L = pathtrace_radiance(s, lights, GRID_ARG, x, *omega, 0, &rng, status);
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);
@@ -25,19 +28,23 @@ static inline vec3 ms_cache_path(NV_CONSTANT const scene_params* s, NV_CONSTANT 
   return L;
 }
 
-/* Adds paths [first, first + count) to node `node`'s running mean (xyz) and count (w). */
-static inline nv_float4 ms_cache_refine_node(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                             GRID_PARAM, NV_CONSTANT const node_grid_params* c, int node, nv_float4 acc,
-                                             uint first, uint count, NV_PRIVATE uint* status) {
+/* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"):
+ * v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch. */
+static inline void ms_cache_refine_node(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                        GRID_PARAM, NV_CONSTANT const node_grid_params* c, int node,
+                                        NV_GLOBAL float* v, uint first, uint count, NV_PRIVATE uint* status) {
   for (uint k = first; k < first + count; ++k) {
-    const vec3 L = ms_cache_path(s, lights, GRID_ARG, c, node, k, status);
+    vec3 omega;
+    const vec3 L = ms_cache_path(s, lights, GRID_ARG, c, node, k, &omega, status);
     const float n = (float)(k + 1u);
-    acc.x += (L.x - acc.x) / n;
-    acc.y += (L.y - acc.y) / n;
-    acc.z += (L.z - acc.z) / n;
-    acc.w = n;
+    const float Lc[3] = {L.x, L.y, L.z};
+    const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */
+    for (int ch = 0; ch < 3; ++ch) {
+      v[ch] += (Lc[ch] - v[ch]) / n;
+      for (int a = 0; a < 3; ++a) v[4 + 4 * ch + a] += (Lc[ch] * w[a] - v[4 + 4 * ch + a]) / n;
+    }
+    v[3] = n;
   }
-  return acc;
 }
 
 #endif

@@ -12,6 +12,7 @@
 #include "render/ms_cache.h"
 #include "render/node_grid.h"
 #include "render/realtime_renderer.h"
+#include "shared/ms_cache.h"
 #include "render_fixture.h"
 #include "test_support.h"
 #include "volume/grid.h"
@@ -104,7 +105,7 @@ std::vector<float> cacheAfter(const Scene& scene, int paths, int perLaunch) {
   DeviceMsCache cache;
   cache.refine(runtime(), dev, params, paths, perLaunch, "lit_box.json");
   EXPECT_EQ(cache.status(), 0u);
-  std::vector<float> v(nodeGridCount(params.ms_cache) * 4);
+  std::vector<float> v(nodeGridCount(params.ms_cache) * MS_CACHE_STRIDE);
   runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, v.size() * sizeof(float), v.data());
   return v;
 }
@@ -115,7 +116,7 @@ TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
   const Scene scene = litBox();
   const std::vector<float> one = cacheAfter(scene, 48, 48), many = cacheAfter(scene, 48, 5);
   EXPECT_EQ(one, many);
-  for (size_t i = 3; i < one.size(); i += 4) ASSERT_EQ(one[i], 48.0f);  // w: the count
+  for (size_t i = 3; i < one.size(); i += MS_CACHE_STRIDE) ASSERT_EQ(one[i], 48.0f);  // the count
 }
 
 // Kept across frames and camera moves, started over when the medium or a light changes: refine()
@@ -159,7 +160,7 @@ TEST(MsCache, ErrorFallsAsOneOverTheSquareRootOfThePaths) {
     const std::vector<float> c = cacheAfter(scene, K, K);
     double se = 0;
     int n = 0;
-    for (size_t i = 0; i < c.size(); i += 4) {
+    for (size_t i = 0; i < c.size(); i += MS_CACHE_STRIDE) {
       const double d = double(c[i]) - ref[i];
       se += d * d;
       ++n;
