@@ -3,7 +3,8 @@
  * which the ray marcher integrates itself with the phase function (raymarch_light_sum, through the
  * light-transmittance cache), and the rest: light scattered at least once, and the background
  * seen through the medium. The rest varies slowly in space and direction; this cache holds its
- * directional average per node of a grid over the medium's box (node_grid.h):
+ * directional average (and first moment, below) per node of a grid over the medium's box
+ * (node_grid.h):
  *   R(x) = (1/4π) ∫ L_rest(x, ω) dω,
  * estimated by the path tracer's own code (pathtrace_radiance with the first segment's emitter
  * left out) from paths started at the node in directions uniform on the sphere (pdf 1/4π, so one
@@ -11,7 +12,7 @@
  * term inside the energy-conserving step: for an isotropic phase function the in-scattered
  * radiance of the rest is exactly σs·R (p = 1/4π against the average), so ray marching plus the
  * cache solves the transport exactly up to the cache's resolution, its noise and the march's
- * quadrature; for HG it is the zeroth moment of the in-scattering (an approximation).
+ * quadrature; for HG it keeps the first two moments of the in-scattering (an approximation).
  *
  * Bounces: the march's sample is the first scattering, so the cache's paths take one bounce
  * fewer than the scene's (the host hands the build a scene with max_bounces − 1): ray marching

@@ -41,9 +41,10 @@
  * Shadow rays: light_cache_optical_depth (light_cache.h): one lookup in the light-transmittance
  * cache when it is on, else a march of shadow_steps samples.
  *
- * Multiple-scattering cache (ms_cache.h; rp->ms_cache.nx > 0): S_k gains σs(x_k) ⊙ R(x_k), the
- * directional average of the radiance arriving at x_k that the light sum above does not hold
- * (scattered at least once, and the background), inside the same energy-conserving step.
+ * Multiple-scattering cache (ms_cache.h; rp->ms_cache.nx > 0): S_k gains σs(x_k) ⊙ (R + g·b·w_out),
+ * the in-scattering towards the camera of the radiance arriving at x_k that the light sum above
+ * does not hold (scattered at least once, and the background), by its directional average R and
+ * first moment b, inside the same energy-conserving step.
  *
  * Early termination (min_transmittance = ε > 0; 0 never stops): the march stops after the step
  * where every channel of T fell below ε' = ε / max(1, max channel of L_b), and the pixel is L + T·L_b
