@@ -72,6 +72,8 @@ struct NativeOptions {
   realtime_params realtime{};           // raymarch / lobe (realtimeParams(scene))
   std::vector<float> lightCache;        // raymarch / lobe with realtime.light_cache.nx > 0: the
                                         // cache's slabs (buildLightCacheOnHost)
+  std::vector<float> msCache;           // stays empty: the multiple-scattering cache is device-only
+                                        // (prepareRealtimeInputs refuses it), so never read
   std::vector<nv_float4> lobeDirections; // lobe: the canonical directions (lobeDirections(...))
 };
 
@@ -164,7 +166,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
           }
           L = vec3_make(ax, ay, az);
         } else if (kind == 1) {
-          L = raymarch_pixel(sp, lights, grid, rp, cache, nullptr, x, y, &status);
+          L = raymarch_pixel(sp, lights, grid, rp, cache, o.msCache.data(), x, y, &status);
         } else {
           L = lobe_pixel(sp, lights, grid, rp, dirs, cache, x, y, &status);
         }
