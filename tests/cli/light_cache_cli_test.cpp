@@ -57,6 +57,26 @@ TEST_F(LightCacheCli, FramesBuildTheCacheOnceAndTheStatsReportIt) {
   EXPECT_EQ(off.out.find("light cache:"), std::string::npos);
 }
 
+// The ray marcher's multiple-scattering cache: built once before the frames and reported apart.
+TEST_F(LightCacheCli, TheMultipleScatteringCacheIsBuiltOnceAndReported) {
+  const RunResult r = run("render s.json -o m.exr --frames 3 --stats-json m.json --set "
+                          "renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
+                          "--set renderer.raymarch.msCache.paths=6 --set renderer.raymarch.msCache.pathsPerLaunch=4");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json s = stats("m.json");
+  EXPECT_EQ(s["ms_cache_cells"], nlohmann::json::array({4, 4, 4}));
+  EXPECT_EQ(s["ms_cache_paths"], 6);  // 4 + 2 in two launches
+  EXPECT_EQ(s["ms_cache_builds"], 1);
+  EXPECT_GT(s["ms_cache_ms"].get<double>(), 0.0);
+  EXPECT_NE(r.out.find("\nmultiple-scattering cache: 4x4x4 cells, 6 paths per node in "), std::string::npos) << r.out;
+  ASSERT_EQ(run("render s.json -o n.exr --stats-json n.json").code, 0);
+  EXPECT_EQ(stats("n.json")["ms_cache_builds"], 0);  // none by default
+  const ImageRGB cached = readExr((dir_ / "m.exr").string()), plain = readExr((dir_ / "n.exr").string());
+  double sumCached = 0, sumPlain = 0;
+  for (size_t i = 0; i < cached.rgb.size(); ++i) sumCached += cached.rgb[i], sumPlain += plain.rgb[i];
+  EXPECT_GT(sumCached, sumPlain);  // light scattered more than once only adds
+}
+
 // Moving the point light is a new cache: the image changes where its light reaches the cloud.
 TEST_F(LightCacheCli, MovingALightChangesTheImage) {
   ASSERT_EQ(run("render s.json -o a.exr --stats-json a.json").code, 0);
@@ -87,6 +107,12 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.minTransmittance: must be in [0, 1) (0 = never stop), got 1\n"},
       {"renderer.lobe.viewSteps=0", "narval: s.json: renderer.lobe.viewSteps: must be at least 1, got 0\n"},
       {"renderer.lobe.firstHitSteps=0", "narval: s.json: renderer.lobe.firstHitSteps: must be at least 1, got 0\n"},
+      {"renderer.raymarch.octaves=4 --set renderer.raymarch.multipleScattering=\\\"cache\\\"",
+       "narval: s.json: renderer.raymarch.octaves: applies only with multipleScattering \"octaves\"\n"},
+      {"renderer.raymarch.multipleScattering=\\\"fog\\\"",
+       "narval: s.json: renderer.raymarch.multipleScattering: unknown value \"fog\" (allowed: none, octaves, cache)\n"},
+      {"renderer.raymarch.msCache.resolution=0",
+       "narval: s.json: renderer.raymarch.msCache.resolution: must be at least 1, got 0\n"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.set);
