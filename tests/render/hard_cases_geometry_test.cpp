@@ -21,13 +21,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-RenderResult renderWith(Scene scene, const std::string& algorithm, const DenseGrid* grid = nullptr) {
-  scene.renderer.algorithm = algorithm;
-  if (algorithm == "pathtrace") return render(scene, grid);
-  return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
-}
-
-const char* const kAlgorithms[] = {"pathtrace", "raymarch", "lobe"};
+const auto& kAlgorithms = kHardCaseRenderers;
 
 
 // The ray mapped into index space by world_to_index (an affine map: the world parameter t is kept).

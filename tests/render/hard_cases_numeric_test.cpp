@@ -17,16 +17,7 @@
 namespace narval::test {
 namespace {
 
-const char* const kAlgorithms[] = {"pathtrace", "raymarch", "lobe"};
-
-RenderResult renderWith(Scene scene, const std::string& algorithm) {
-  if (algorithm == "pathtrace") return render(scene);
-  scene.renderer.algorithm = algorithm;
-  RenderOptions o;
-  o.localSizeX = 8;
-  o.localSizeY = 8;
-  return renderRealtime(runtime(), scene, nullptr, 1, o);
-}
+const auto& kAlgorithms = kHardCaseRenderers;
 
 size_t nonFinite(const ImageRGB& img) {
   size_t n = 0;

@@ -39,6 +39,26 @@ inline RenderResult renderAlgorithm(const Scene& scene, const DenseGrid* grid = 
   return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
 }
 
+// What the hard-case suites render: every algorithm, and the ray marcher with its
+// multiple-scattering cache ("raymarch+ms-cache": a small one, 4 cells and 8 paths per node, so the
+// suites stay fast; every code path of the cache's build and lookup runs).
+inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "raymarch+ms-cache", "lobe"};
+
+// `scene` rendered by one of kHardCaseRenderers (or any algorithm name), one frame for the
+// real-time ones.
+inline RenderResult renderWith(Scene scene, const std::string& renderer, const DenseGrid* grid = nullptr) {
+  if (renderer == "raymarch+ms-cache") {
+    scene.renderer.algorithm = "raymarch";
+    scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
+    scene.renderer.raymarch.msCache.resolution = 4;
+    scene.renderer.raymarch.msCache.paths = 8;
+  } else {
+    scene.renderer.algorithm = renderer;
+  }
+  if (scene.renderer.algorithm == "pathtrace") return render(scene, grid);
+  return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
+}
+
 // A ray in double precision.
 struct Ray {
   double o[3], d[3];
