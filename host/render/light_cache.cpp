@@ -37,7 +37,7 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   const node_grid_params& c = params.light_cache;
   if (c.nx <= 0) throw std::invalid_argument("DeviceLightCache::update: the cache is off (nx = 0)");
   const int numLights = dev.scene.params.num_lights;
-  const size_t nodes = size_t(c.nx) * size_t(c.ny) * size_t(c.nz);
+  const size_t nodes = nodeGridCount(c);
   // Everything a slab depends on besides its light. The grid is identified by its address: a
   // DeviceSceneBuffers keeps its grid for its life, and a new scene makes a new one.
   const std::string key = rawBytes(dev.scene.params.medium) + rawBytes(dev.scene.grid) + rawBytes(c) +
@@ -67,18 +67,14 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   kernel_.setArg(arg + 0, paramBuf_);
   kernel_.setArg(arg + 2, buffer_);
   kernel_.setArg(arg + 3, statusBuf_);
-  const size_t local = 64, global = (nodes + local - 1) / local * local;
   for (int l : stale) {
     kernel_.setArg(arg + 1, cl_int(l));
-    const cl::Event ev = launchAndWait(rt, kernel_, cl::NDRange(global), cl::NDRange(local),
-                                       "the light-transmittance cache", deviceSceneBytes(dev.scene) + bytes_);
-    buildMs_ += eventSeconds(ev) * 1e3;
+    buildMs_ +=
+        launchOverNodes(rt, kernel_, nodes, "the light-transmittance cache", deviceSceneBytes(dev.scene) + bytes_);
     lights_[size_t(l)] = dev.scene.lights[size_t(l)];
     ++slabsBuilt_;
   }
-  cl_uint st = 0;
-  rt.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof st, &st);
-  status_ |= st;
+  status_ |= readStatusWord(rt, statusBuf_);
   mediumKey_ = key;
 }
 

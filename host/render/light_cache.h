@@ -7,7 +7,6 @@
 // nothing, and moving one light rebuilds its slab alone.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>

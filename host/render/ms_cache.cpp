@@ -45,19 +45,15 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   kernel_.setArg(arg + 0, paramBuf_);
   kernel_.setArg(arg + 3, buffer_);
   kernel_.setArg(arg + 4, statusBuf_);
-  const size_t local = 64, global = (nodes + local - 1) / local * local;
   while (paths_ < targetPaths) {
     const int count = std::min(std::max(1, pathsPerLaunch), targetPaths - paths_);
     kernel_.setArg(arg + 1, cl_uint(paths_));
     kernel_.setArg(arg + 2, cl_uint(count));
-    const cl::Event ev = launchAndWait(rt, kernel_, cl::NDRange(global), cl::NDRange(local),
-                                       "the multiple-scattering cache", deviceSceneBytes(dev.scene) + bytes_);
-    buildMs_ += eventSeconds(ev) * 1e3;
+    buildMs_ +=
+        launchOverNodes(rt, kernel_, nodes, "the multiple-scattering cache", deviceSceneBytes(dev.scene) + bytes_);
     paths_ += count;
   }
-  cl_uint st = 0;
-  rt.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof st, &st);
-  status_ |= st;
+  status_ |= readStatusWord(rt, statusBuf_);
 }
 
 }  // namespace narval

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/render_common.h"
+
 namespace narval {
 
 node_grid_params nodeGridLayout(const DeviceScene& ds, int cells) {
@@ -26,6 +28,19 @@ node_grid_params nodeGridLayout(const DeviceScene& ds, int cells) {
 }
 
 size_t nodeGridCount(const node_grid_params& c) { return size_t(c.nx) * size_t(c.ny) * size_t(c.nz); }
+
+double launchOverNodes(ClRuntime& rt, const cl::Kernel& kernel, size_t nodes, const std::string& what,
+                       size_t deviceBytes) {
+  const size_t local = 64, global = (nodes + local - 1) / local * local;
+  const cl::Event ev = launchAndWait(rt, kernel, cl::NDRange(global), cl::NDRange(local), what, deviceBytes);
+  return eventSeconds(ev) * 1e3;
+}
+
+uint32_t readStatusWord(ClRuntime& rt, const cl::Buffer& statusBuf) {
+  cl_uint st = 0;
+  rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof st, &st);
+  return st;
+}
 
 void nodeGridCells(const node_grid_params& c, int cells[3]) {
   cells[0] = std::max(0, c.nx - 1);

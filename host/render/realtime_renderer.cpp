@@ -66,7 +66,6 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   const realtime_params params = realtimeParams(scene, dev.scene, rt.selected.info.maxAllocBytes);
   DeviceLightCache lightCache;
   DeviceMsCache msCache;
-  cl::Buffer noCache;
   const scene_params& sp = dev.scene.params;
   const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
   std::vector<nv_float4> dirs = algorithm == "lobe" ? lobeDirections(params.lobe_points, g, scene.renderer.seed)
@@ -89,7 +88,7 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
   kernel.setArg(arg + 1, dirBuf);
   kernel.setArg(arg + 4, outBuf);
   kernel.setArg(arg + 5, statusBuf);
-  noCache = cl::Buffer(rt.context, CL_MEM_READ_ONLY, sizeof(float));  // for a cache that is off: never read
+  const cl::Buffer noCache(rt.context, CL_MEM_READ_ONLY, sizeof(float));  // for a cache that is off: never read
   if (params.light_cache.nx == 0) kernel.setArg(arg + 2, noCache);
   if (params.ms_cache.nx == 0) kernel.setArg(arg + 3, noCache);
   rt.queue.finish();
