@@ -31,6 +31,10 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   p.depth_factor = r.lobe.depthFactor;
   p.lobe_radius = r.lobe.lobeRadius;
   p.lobe_points = r.lobe.lobePoints;
+  switch (r.lobe.variant) {
+    case LobeVariant::Eq7: p.lobe_variant = LOBE_EQ7; break;
+    case LobeVariant::Corrected: p.lobe_variant = LOBE_CORRECTED; break;
+  }
   p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
   if (!lobe && r.raymarch.multipleScattering == MultipleScattering::Cache)
     p.ms_cache = nodeGridLayout(ds, r.raymarch.msCache.resolution);

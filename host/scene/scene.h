@@ -96,10 +96,14 @@ struct RaymarchSettings {
   MsCacheSettings msCache;
 };
 
+// The Lobe Estimator: the dissertation's Eq. 7, or the corrected estimator (kernels/shared/lobe.h).
+enum class LobeVariant { Eq7, Corrected };
+
 struct LobeSettings {
+  LobeVariant variant = LobeVariant::Eq7;
   float depthFactor = 20.0f;
   int lobePoints = 30;
-  float lobeRadius = 1.0f;
+  float lobeRadius = 1.0f;       // eq7: world units; corrected: mean free paths of unit density
   int shadowSteps = 100;
   int firstHitSteps = 60;        // samples of the first-hit search (then 6 bisections)
   int viewSteps = 24;            // samples of each transmittance from the first hit to a lobe point

@@ -58,12 +58,15 @@
 // |   raymarch.multipleScattering | none, octaves, cache      |     | none        | octaves when octaves > 1   |
 // |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]                   |
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
-// |   lobe.depthFactor      | number                          |     | 20          | >= 0                       |
+// |   lobe.variant          | eq7, corrected (lobe.h)         |     | eq7         |                            |
+// |   lobe.depthFactor      | number (eq7)                    |     | 20          | >= 0                       |
 // |   lobe.lobePoints       | integer                         |     | 30          | >= 1                       |
-// |   lobe.lobeRadius       | number, world units             |     | 1           | >= 0                       |
+// |   lobe.lobeRadius       | number: eq7 world units,        |     | 1           | >= 0                       |
+// |                         | corrected mean free paths       |     |             |                            |
 // |   lobe.shadowSteps      | integer                         |     | 100         | >= 1                       |
-// |   lobe.firstHitSteps    | integer                         |     | 60          | >= 1                       |
-// |   lobe.viewSteps        | integer: Tr(x0 -> P_i) samples  |     | 24          | >= 1                       |
+// |   lobe.firstHitSteps    | integer (eq7)                   |     | 60          | >= 1                       |
+// |   lobe.viewSteps        | integer: Tr(x0 -> P_i) samples; |     | 24          | >= 1                       |
+// |                         | corrected: the one view march   |     |             |                            |
 // |   lobe.minTransmittance | number: Tr(x0 -> P_i) stops     |     | 0.001       | [0, 1); 0 = never          |
 // |   lightCache.resolution | "auto" or integer: cells on the |     | auto        | [0, 1024]; 0 = off (exact  |
 // |                         | box's longest axis              |     |             | shadow marches)            |
@@ -142,6 +145,7 @@ const EnumNames<GridStorage> kGridStorages = {{"auto", GridStorage::Auto},
 const EnumNames<MultipleScattering> kMultipleScattering = {{"none", MultipleScattering::None},
                                                            {"octaves", MultipleScattering::Octaves},
                                                            {"cache", MultipleScattering::Cache}};
+const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
 const EnumNames<std::string> kAlgorithms = {{"pathtrace", "pathtrace"},
                                             {"raymarch", "raymarch"},
                                             {"lobe", "lobe"}};
@@ -354,6 +358,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
   }
   if (const json* v = r.find("lobe")) {
     ObjectReader l(ctx, *v, r.keyOf("lobe"));
+    s.lobe.variant = readEnum(l, "variant", kLobeVariants, s.lobe.variant);
     s.lobe.depthFactor = readNonNegative(l, "depthFactor", s.lobe.depthFactor);
     s.lobe.lobePoints = readInt(l, "lobePoints", s.lobe.lobePoints, 1);
     s.lobe.lobeRadius = readNonNegative(l, "lobeRadius", s.lobe.lobeRadius);

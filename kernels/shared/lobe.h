@@ -57,6 +57,39 @@
  * view_steps + lights × (one cache lookup or a march of shadow_steps)): all bounded by the scene's
  * parameters; the only open-ended walk is the DDA under each march, capped by its budget
  * (majorant.h).
+ *
+ * Corrected (renderer.lobe.variant "corrected"; "eq7", the default, is all of the above, bit for
+ * bit). It keeps the idea (HG-distributed points about a point inside the medium past the view
+ * ray's entry, their light averaged) and changes what the measurements showed wrong:
+ * C1. Eq. 7's in-scattered term does not depend on how much the medium scatters: a wisp of
+ *     density 1e-6 gets the same albedo·S̄ as a dense core (the white sheet around the smoke). The
+ *     single-scattering integral along the view ray, with the in-scattered radiance S taken as
+ *     constant along it, is ∫ σs(t) T(t) S dt = albedo·S·∫ σt(t) T(t) dt = albedo·S·(1 − T_v)
+ *     (since d/dt T = −σt T and albedo = σs/σt is the same at every density), T_v the view ray's
+ *     transmittance through the box. So the term is weighted by (1 − T_v): as the density → 0,
+ *     T_v → 1 and L → L_b continuously. The background term becomes L_b·T_v, what reaches the
+ *     camera unscattered (Eq. 7's mean Tr(x0 → P_i) counts light that the lobe points see, not the
+ *     camera; dropping it also drops its n view marches). One march of view_steps samples over the
+ *     occupied cells gives T_v.
+ * C2. The centre: the same march gives the expected depth of the view ray's first interaction,
+ *     t_c = ∫ t σt T dt / ∫ σt T dt (midpoint rule, channel mean): where the light S stands for
+ *     is scattered to the camera. Eq. 7's depth_factor/σ̄t measures depth with unit density, so
+ *     in a thin wisp or a dense core c lands where nothing scatters (the black core and white ring
+ *     on the default cloud). t_c lies between the entry and the last sample with density (it is a
+ *     weighted mean of sample positions), inside the box; first-hit search and depth_factor are
+ *     not used. Early termination as in step 4: the march stops once every channel's τ exceeds
+ *     −ln ε'; the samples left carry weight below ε' together, so 1 − T_v is off by less than ε'
+ *     (relative error of the in-scattered term below ε'/(1 − ε')).
+ * C3. Scale: lobe_radius is in mean free paths of unit density, r = lobe_radius/σ̄t. Scaling the
+ *     geometry by s and σ by 1/s scales r, t_c and every segment by s and leaves every optical
+ *     depth, T_v, phase angle and (for rectangle lights, I ∝ area) I/d² unchanged: the same image.
+ *     Eq. 7's r in world units gives another picture at another scale.
+ * C4. The lobe stays inside the medium: P_i = c + min(r, distance from c to the box along d_i)·d_i.
+ *     A point outside the box sees its light unshadowed, which Eq. 7 paints as a bright ring
+ *     around silhouettes.
+ * Result: L = L_b·T_v + (1 − T_v)·albedo ⊙ (1/n) Σ_i Σ_k p(cos θ_i) · Tr(P_i → light_k) · I_k / d².
+ * Loops: one march of view_steps, n × lights lookups; no first-hit search, no view marches.
+ *
  * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density, phase value or
  * lobe point met on the way; STATUS_ITERATION_CAP from a DDA walk. No pdf: never
  * STATUS_NEGATIVE_PDF. */
@@ -127,6 +160,134 @@ static inline vec3 lobe_transmittance_between(NV_CONSTANT const medium_params* m
                                                   status));
 }
 
+/* Adds to *in_sum the light of every light at lobe point P scattered towards c (direction −d, d the
+ * lobe direction that placed P): Σ_k p(cos θ) · Tr(P → light_k) · I_k / |light_k − P|². Terms are
+ * added light by light into *in_sum, the order Eq. 7's pixels were recorded with. */
+static inline void lobe_add_inscattered(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                        GRID_PARAM, NV_CONSTANT const realtime_params* p,
+                                        NV_GLOBAL const float* light_cache, vec3 P, vec3 d, NV_PRIVATE vec3* in_sum,
+                                        NV_PRIVATE uint* status) {
+  NV_CONSTANT const medium_params* m = &s->medium;
+  const vec3 w_out = vec3_scale(d, -1.0f); /* from P towards c */
+  for (int k = 0; k < s->num_lights; ++k) {
+    vec3 to_light, I;
+    float dist;
+    if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
+    /* w_in: the light's propagation direction, light → P. */
+    const float f = phase_eval(m->phase, m->g, vec3_scale(to_light, -1.0f), w_out);
+    if (!(f > 0.0f)) {
+      if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
+      continue;
+    }
+    const vec3 tr = vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, k, P, to_light, dist, status));
+    *in_sum = vec3_add(*in_sum, vec3_scale(vec3_mul(tr, I), f / (dist * dist)));
+  }
+}
+
+/* σs/σt per channel (0 where σt = 0). */
+static inline vec3 lobe_albedo(NV_CONSTANT const medium_params* m) {
+  const vec3 sig_s = vec3_from4(m->sigma_s);
+  const vec3 sig_t = vec3_add(vec3_from4(m->sigma_a), sig_s);
+  return vec3_make(sig_t.x > 0.0f ? sig_s.x / sig_t.x : 0.0f, sig_t.y > 0.0f ? sig_s.y / sig_t.y : 0.0f,
+                   sig_t.z > 0.0f ? sig_s.z / sig_t.z : 0.0f);
+}
+
+/* Lobe direction i: the canonical direction q (about +Z) in the frame (tx, ty, ω). */
+static inline vec3 lobe_direction(vec3 tx, vec3 ty, vec3 dir, nv_float4 q) {
+  return vec3_add(vec3_add(vec3_scale(tx, q.x), vec3_scale(ty, q.y)), vec3_scale(dir, q.z));
+}
+
+/* Eq. 7 (header comment, steps 1-4), bit for bit as the dissertation's reproduction records it. */
+static inline vec3 lobe_radiance_eq7(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                     GRID_PARAM, NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
+                                     NV_GLOBAL const float* light_cache, vec3 origin, vec3 dir, vec3 tx, vec3 ty,
+                                     vec3 Lb, NV_PRIVATE const medium_segment* seg, NV_PRIVATE uint* status) {
+  NV_CONSTANT const medium_params* m = &s->medium;
+  /* 1. First hit. */
+  float t_x0;
+  if (!lobe_first_hit(m, GRID_ARG, seg, p->steps, &t_x0, status)) return Lb;
+  const vec3 x0 = vec3_madd(origin, dir, t_x0);
+
+  /* 2. Lobe centre, depth clamped to the rest of the segment inside the box. */
+  const float mean_sigma_t = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  const float rest = seg->t1 - t_x0;
+  const float depth = p->depth_factor < mean_sigma_t * rest ? p->depth_factor / mean_sigma_t : rest;
+  const vec3 c = vec3_madd(x0, dir, depth);
+
+  /* 4. Sums over the lobe points. */
+  const int n = p->lobe_points;
+  const int view_term = !vec3_is_zero(Lb);
+  const float tau_limit = p->min_transmittance > 0.0f
+                              ? -nv_log(p->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
+                              : NV_INFINITY;
+  vec3 tr_sum = vec3_splat(0.0f), in_sum = vec3_splat(0.0f);
+  for (int i = 0; i < n; ++i) {
+    const vec3 d = lobe_direction(tx, ty, dir, dirs[i]);
+    const vec3 P = vec3_madd(c, d, p->lobe_radius);
+    if (view_term)
+      tr_sum = vec3_add(tr_sum, lobe_transmittance_between(m, GRID_ARG, x0, P, p->view_steps, tau_limit, status));
+    lobe_add_inscattered(s, lights, GRID_ARG, p, light_cache, P, d, &in_sum, status);
+  }
+  const float fn = (float)n;
+  const vec3 tr_mean = vec3_make(tr_sum.x / fn, tr_sum.y / fn, tr_sum.z / fn);
+  const vec3 in_mean = vec3_make(in_sum.x / fn, in_sum.y / fn, in_sum.z / fn);
+  return vec3_add(vec3_mul(Lb, tr_mean), vec3_mul(lobe_albedo(m), in_mean));
+}
+
+/* The corrected estimator (header comment, "Corrected"). */
+static inline vec3 lobe_radiance_corrected(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                           GRID_PARAM, NV_CONSTANT const realtime_params* p,
+                                           NV_GLOBAL const nv_float4* dirs, NV_GLOBAL const float* light_cache,
+                                           vec3 origin, vec3 dir, vec3 tx, vec3 ty, vec3 Lb,
+                                           NV_PRIVATE const medium_segment* seg, NV_PRIVATE uint* status) {
+  NV_CONSTANT const medium_params* m = &s->medium;
+  /* C1. One march of the view ray: its transmittance T_v and the expected depth of its first
+   * interaction, t_c = Σ w_k t_k / Σ w_k with w_k = T(before k)·(1 − e^{−σ̄t,k Δ}) (channel mean). */
+  const float tau_limit = p->min_transmittance > 0.0f
+                              ? -nv_log(p->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
+                              : NV_INFINITY;
+  march_iter it = march_begin(m, GRID_ARG, seg, p->view_steps);
+  *status |= it.status;
+  vec3 tau = vec3_splat(0.0f);
+  float w_sum = 0.0f, wt_sum = 0.0f, ws_sum = 0.0f, wst_sum = 0.0f, t;
+  while (march_next(&it, GRID_ARG, &t)) {
+    const vec3 dtau = vec3_scale(march_sigma_t(m, GRID_ARG, seg, t), it.delta);
+    const float w = nv_exp(-vec3_average(tau)) * (1.0f - nv_exp(-vec3_average(dtau)));
+    vec3 S = vec3_splat(0.0f);
+    if (w > 0.0f) lobe_add_inscattered(s, lights, GRID_ARG, p, light_cache, vec3_madd(origin, dir, t), dir, &S, status);
+    const float ws = w * vec3_average(S);
+    w_sum += w;
+    wt_sum += w * t;
+    ws_sum += ws;
+    wst_sum += ws * t;
+    tau = vec3_add(tau, dtau);
+    if (nv_fmin(tau.x, nv_fmin(tau.y, tau.z)) > tau_limit) break;
+  }
+  if (!(w_sum > 0.0f)) {
+    if (w_sum != w_sum) *status |= STATUS_NAN; /* a NaN density, not empty space */
+    return Lb;
+  }
+  const vec3 Tv = vec3_exp_neg(tau);
+  const vec3 c = vec3_madd(origin, dir, ws_sum > 0.0f ? wst_sum / ws_sum : wt_sum / w_sum);
+
+  /* C2-C3. Lobe points at r = lobe_radius mean free paths of unit density, each pulled in to the
+   * box's boundary along its own direction. */
+  const float r = p->lobe_radius / vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  const int n = p->lobe_points;
+  vec3 in_sum = vec3_splat(0.0f);
+  for (int i = 0; i < n; ++i) {
+    const vec3 d = lobe_direction(tx, ty, dir, dirs[i]);
+    medium_segment inside;
+    const float reach = medium_intersect(m, c, d, 0.0f, r, &inside) ? inside.t1 : 0.0f;
+    lobe_add_inscattered(s, lights, GRID_ARG, p, light_cache, vec3_madd(c, d, reach), d, &in_sum, status);
+  }
+  const float fn = (float)n;
+  const vec3 in_mean = vec3_make(in_sum.x / fn, in_sum.y / fn, in_sum.z / fn);
+  /* C4. L = L_b·T_v + (1 − T_v)·albedo·S̄. */
+  const vec3 opacity = vec3_sub(vec3_splat(1.0f), Tv);
+  return vec3_add(vec3_mul(Lb, Tv), vec3_mul(vec3_mul(opacity, lobe_albedo(m)), in_mean));
+}
+
 /* Radiance of the view ray from `origin` along unit `dir`. `right` is the camera's unit right
  * vector (the lobe frame's reference, see the header comment); `dirs` holds p->lobe_points unit
  * directions about +Z. */
@@ -140,61 +301,16 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
   float t_surf;
   int front = 0;
   intersect_lights(lights, s->num_lights, origin, dir, 0.0f, -1, &t_surf, &front);
-  NV_CONSTANT const medium_params* m = &s->medium;
   medium_segment seg;
-  if (!medium_intersect(m, origin, dir, 0.0f, t_surf, &seg)) return Lb;
-
-  /* 1. First hit. */
-  float t_x0;
-  if (!lobe_first_hit(m, GRID_ARG, &seg, p->steps, &t_x0, status)) return Lb;
-  const vec3 x0 = vec3_madd(origin, dir, t_x0);
-
-  /* 2. Lobe centre, depth clamped to the rest of the segment inside the box. */
-  const vec3 sig_s = vec3_from4(m->sigma_s);
-  const vec3 sig_t = vec3_add(vec3_from4(m->sigma_a), sig_s);
-  const float mean_sigma_t = vec3_average(sig_t);
-  const float rest = seg.t1 - t_x0;
-  const float depth = p->depth_factor < mean_sigma_t * rest ? p->depth_factor / mean_sigma_t : rest;
-  const vec3 c = vec3_madd(x0, dir, depth);
-  const vec3 albedo = vec3_make(sig_t.x > 0.0f ? sig_s.x / sig_t.x : 0.0f, sig_t.y > 0.0f ? sig_s.y / sig_t.y : 0.0f,
-                                sig_t.z > 0.0f ? sig_s.z / sig_t.z : 0.0f);
+  if (!medium_intersect(&s->medium, origin, dir, 0.0f, t_surf, &seg)) return Lb;
 
   /* 3. Frame (t, b, ω) from the camera's right vector; (t, b, ω) is right-handed. */
   const vec3 tx = vec3_normalize(vec3_madd(right, dir, -vec3_dot(right, dir)));
   const vec3 ty = vec3_cross(dir, tx);
-
-  /* 4. Sums over the lobe points. */
-  const int n = p->lobe_points;
-  const int view_term = !vec3_is_zero(Lb);
-  const float tau_limit = p->min_transmittance > 0.0f
-                              ? -nv_log(p->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
-                              : NV_INFINITY;
-  vec3 tr_sum = vec3_splat(0.0f), in_sum = vec3_splat(0.0f);
-  for (int i = 0; i < n; ++i) {
-    const nv_float4 q = dirs[i];
-    const vec3 d = vec3_add(vec3_add(vec3_scale(tx, q.x), vec3_scale(ty, q.y)), vec3_scale(dir, q.z));
-    const vec3 P = vec3_madd(c, d, p->lobe_radius);
-    if (view_term)
-      tr_sum = vec3_add(tr_sum, lobe_transmittance_between(m, GRID_ARG, x0, P, p->view_steps, tau_limit, status));
-    const vec3 w_out = vec3_scale(d, -1.0f); /* from P_i towards c */
-    for (int k = 0; k < s->num_lights; ++k) {
-      vec3 to_light, I;
-      float dist;
-      if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
-      /* w_in: the light's propagation direction, light → P_i. */
-      const float f = phase_eval(m->phase, m->g, vec3_scale(to_light, -1.0f), w_out);
-      if (!(f > 0.0f)) {
-        if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
-        continue;
-      }
-      const vec3 tr = vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, k, P, to_light, dist, status));
-      in_sum = vec3_add(in_sum, vec3_scale(vec3_mul(tr, I), f / (dist * dist)));
-    }
-  }
-  const float fn = (float)n;
-  const vec3 tr_mean = vec3_make(tr_sum.x / fn, tr_sum.y / fn, tr_sum.z / fn);
-  const vec3 in_mean = vec3_make(in_sum.x / fn, in_sum.y / fn, in_sum.z / fn);
-  return vec3_add(vec3_mul(Lb, tr_mean), vec3_mul(albedo, in_mean));
+  if (p->lobe_variant == LOBE_CORRECTED)
+    return lobe_radiance_corrected(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status);
+  /* LOBE_EQ7, the only other variant the host writes (scene_load.cpp). */
+  return lobe_radiance_eq7(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status);
 }
 
 /* The pixel (px, py): ray through its centre (deterministic, no jitter). Non-finite results are

@@ -86,6 +86,10 @@ typedef struct node_grid_params {
   int pad0;
 } node_grid_params;
 
+/* Lobe Estimator variants (lobe.h): the dissertation's Eq. 7, and the corrected estimator. */
+#define LOBE_EQ7 0
+#define LOBE_CORRECTED 1
+
 /* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
 typedef struct realtime_params {
   int steps;            /* raymarch: samples over the view ray's segment; lobe: first-hit search samples */
@@ -95,11 +99,11 @@ typedef struct realtime_params {
   float octave_b;       /* extinction scale per octave (a <= b conserves energy) */
   float octave_c;       /* phase anisotropy scale per octave */
   float depth_factor;   /* lobe: centre at depth_factor mean free paths past the first hit */
-  float lobe_radius;    /* lobe: world units */
+  float lobe_radius;    /* lobe: eq7 world units; corrected mean free paths of unit density */
   int lobe_points;      /* lobe: directions in the lobe_directions buffer */
   int view_steps;       /* lobe: samples of each transmittance from the first hit to a lobe point */
   float min_transmittance; /* view marches stop once every channel's transmittance is below it; 0: never */
-  int pad0;
+  int lobe_variant;     /* lobe: LOBE_EQ7 or LOBE_CORRECTED (lobe.h) */
   node_grid_params light_cache; /* the light-transmittance cache (light_cache.h); nx = 0: off */
   node_grid_params ms_cache;    /* raymarch: the multiple-scattering cache (ms_cache.h); nx = 0: off */
 } realtime_params;

@@ -113,6 +113,8 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.multipleScattering: unknown value \"fog\" (allowed: none, octaves, cache)\n"},
       {"renderer.raymarch.msCache.resolution=0",
        "narval: s.json: renderer.raymarch.msCache.resolution: must be at least 1, got 0\n"},
+      {"renderer.lobe.variant=\\\"eq8\\\"",
+       "narval: s.json: renderer.lobe.variant: unknown value \"eq8\" (allowed: eq7, corrected)\n"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.set);

@@ -35,7 +35,7 @@
   F(realtime_params, octaves) F(realtime_params, octave_a) F(realtime_params, octave_b)           \
   F(realtime_params, octave_c) F(realtime_params, depth_factor) F(realtime_params, lobe_radius)   \
   F(realtime_params, lobe_points) F(realtime_params, view_steps)                                  \
-  F(realtime_params, min_transmittance) F(realtime_params, pad0) F(realtime_params, light_cache)  \
+  F(realtime_params, min_transmittance) F(realtime_params, lobe_variant) F(realtime_params, light_cache)\
   F(realtime_params, light_cache.nz) F(realtime_params, ms_cache) F(realtime_params, ms_cache.nz)  \
   S(node_grid_params) F(node_grid_params, index_to_world) F(node_grid_params, nx)           \
   F(node_grid_params, ny) F(node_grid_params, nz) F(node_grid_params, pad0)

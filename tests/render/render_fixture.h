@@ -42,7 +42,8 @@ inline RenderResult renderAlgorithm(const Scene& scene, const DenseGrid* grid = 
 // What the hard-case suites render: every algorithm, and the ray marcher with its
 // multiple-scattering cache ("raymarch+ms-cache": a small one, 4 cells and 8 paths per node, so the
 // suites stay fast; every code path of the cache's build and lookup runs).
-inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "raymarch+ms-cache", "lobe"};
+inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "raymarch+ms-cache", "lobe",
+                                                 "lobe+corrected"};
 
 // `scene` rendered by one of kHardCaseRenderers (or any algorithm name), one frame for the
 // real-time ones.
@@ -52,6 +53,9 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, const D
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
     scene.renderer.raymarch.msCache.resolution = 4;
     scene.renderer.raymarch.msCache.paths = 8;
+  } else if (renderer == "lobe+corrected") {
+    scene.renderer.algorithm = "lobe";
+    scene.renderer.lobe.variant = LobeVariant::Corrected;
   } else {
     scene.renderer.algorithm = renderer;
   }
