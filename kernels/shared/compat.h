@@ -19,6 +19,8 @@ typedef ulong nv_ulong; /* 64-bit unsigned (counters, tracking.h) */
 #define nv_sqrt sqrt
 #define nv_exp exp
 #define nv_log log
+#define nv_expm1 expm1
+#define nv_log1p log1p
 #define nv_fabs fabs
 #define nv_fmin fmin
 #define nv_fmax fmax
@@ -50,6 +52,8 @@ static inline vec3 vec3_make(float x, float y, float z) {
 #define nv_sqrt sqrtf
 #define nv_exp expf
 #define nv_log logf
+#define nv_expm1 expm1f
+#define nv_log1p log1pf
 #define nv_fabs fabsf
 #define nv_fmin fminf
 #define nv_fmax fmaxf

@@ -2,7 +2,8 @@
  * caches"; the per-light "shadow volume" production engines keep, e.g. Hillaire 2016, Frostbite's
  * volumetric shadow maps). Per light, a grid of nodes over the medium's box holding what every
  * shadow ray of raymarch.h and lobe.h would otherwise march: the column density from the node to
- * the light (the point march_light_position gives: a point light, a rectangle's centre).
+ * the light (march_light_column: a point light; a rectangle's centre, or with area_light_samples
+ * K > 1 its effective column over K×K points of its area).
  *
  * Layout: a node grid over the medium's box (node_grid.h, realtime_params.light_cache), one slab
  * of nodes per light, the slabs one after the other.
@@ -29,20 +30,14 @@
 #include "shared/node_grid.h"
 
 /* What node `node` of light l's slab holds: the column density from the node to the light over
- * the kernel's shadow quadrature; 0 when the light sits on the node (nothing lies between).
+ * the kernel's shadow quadrature (march_light_column: with K > 1 a rectangle's effective column
+ * over its K×K points); 0 when the light sits on the node (nothing lies between).
  * Status word: STATUS_NAN for a NaN node point or column; STATUS_ITERATION_CAP from a DDA walk. */
 static inline float light_cache_build_node(NV_CONSTANT const medium_params* m, GRID_PARAM,
-                                           NV_CONSTANT const node_grid_params* c, int shadow_steps,
+                                           NV_CONSTANT const node_grid_params* c, int shadow_steps, int K,
                                            NV_CONSTANT const light_params* l, int node, NV_PRIVATE uint* status) {
   const vec3 x = affine_point(c->index_to_world, node_grid_point(c, vec3_from4(m->dims), node));
-  const vec3 to = vec3_sub(march_light_position(l), x);
-  const float d2 = vec3_dot(to, to);
-  if (!(d2 > 0.0f)) {
-    if (d2 != d2) *status |= STATUS_NAN;
-    return 0.0f;
-  }
-  const float dist = nv_sqrt(d2);
-  const float column = march_column_density(m, GRID_ARG, x, vec3_scale(to, 1.0f / dist), dist, shadow_steps, status);
+  const float column = march_light_column(m, GRID_ARG, l, x, K, shadow_steps, status);
   if (column != column) *status |= STATUS_NAN; /* a NaN density on the way: said, not cached silently */
   return column;
 }
@@ -76,11 +71,15 @@ static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_CO
  * for every shadow ray. */
 static inline vec3 light_cache_optical_depth(NV_CONSTANT const medium_params* m, GRID_PARAM,
                                              NV_CONSTANT const realtime_params* rp, NV_GLOBAL const float* cache,
-                                             int light, vec3 x, vec3 dir, float dist, NV_PRIVATE uint* status) {
-  if (rp->light_cache.nx > 0) {
-    const vec3 sigma_t_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+                                             NV_CONSTANT const light_params* lights, int light, vec3 x, vec3 dir,
+                                             float dist, NV_PRIVATE uint* status) {
+  const vec3 sigma_t_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+  if (rp->light_cache.nx > 0)
     return vec3_scale(sigma_t_unit, light_cache_column(m, &rp->light_cache, cache, light, x, dir, dist, status));
-  }
+  if (rp->area_light_samples > 1 && LIGHT_IS_RECT(&lights[light])) /* the columns the cache would hold */
+    return vec3_scale(sigma_t_unit,
+                      march_light_column(m, GRID_ARG, &lights[light], x, rp->area_light_samples, rp->shadow_steps,
+                                         status));
   return march_optical_depth(m, GRID_ARG, x, dir, dist, rp->shadow_steps, status);
 }
 

@@ -173,13 +173,20 @@ static inline void lobe_add_inscattered(NV_CONSTANT const scene_params* s, NV_CO
     vec3 to_light, I;
     float dist;
     if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
+    if (p->area_light_samples > 1) {
+      /* Rectangles as K×K points (march_light_phase_sum), shadowed towards their centre. */
+      const vec3 tr = vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, lights, k, P, to_light, dist, status));
+      *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase_sum(&lights[k], P, m->phase, m->g, d,
+                                                                      p->area_light_samples)));
+      continue;
+    }
     /* w_in: the light's propagation direction, light → P. */
     const float f = phase_eval(m->phase, m->g, vec3_scale(to_light, -1.0f), w_out);
     if (!(f > 0.0f)) {
       if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
       continue;
     }
-    const vec3 tr = vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, k, P, to_light, dist, status));
+    const vec3 tr = vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, lights, k, P, to_light, dist, status));
     *in_sum = vec3_add(*in_sum, vec3_scale(vec3_mul(tr, I), f / (dist * dist)));
   }
 }

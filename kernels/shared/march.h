@@ -12,6 +12,7 @@
 #include "shared/grid.h"
 #include "shared/majorant.h"
 #include "shared/medium.h"
+#include "shared/phase.h"
 
 /* σt at world point o + t·d of a medium segment (index-space origin and direction in `seg`). */
 static inline vec3 march_sigma_t(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_PRIVATE const medium_segment* seg,
@@ -168,6 +169,92 @@ static inline int march_light_as_point(NV_CONSTANT const light_params* l, vec3 x
   }
   *intensity = I;
   return 1;
+}
+
+/* Light l's unshadowed in-scattering at x per unit σs, Σ_j I_j·p(g, view_dir·dir_j)/d_j² (view_dir
+ * the propagation direction before scattering, e.g. away from the camera): a point light is itself;
+ * a rectangle is K×K points at the centres of a K×K split of its area, each with intensity
+ * Le·(A/K²)·max(0, cos θ_j) towards x (the midpoint rule over the area, as the path tracer's area
+ * light integrates exactly). Why not the centre alone (K = 1, march_light_as_point): with a
+ * forward-peaked phase function the phase angle changes across the light by more than the lobe's
+ * width (HG(0.8) halves within 10°; a 6-unit light 20 units away spans 17°), and the centre's
+ * value is then far off the average (single scattering 30% dark on the default cloud at g 0.8,
+ * within 1% at g 0). The shadow is the caller's: the transmittance towards the centre. */
+static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3 x, int phase_kind, float g,
+                                         vec3 view_dir, int K) {
+  const vec3 Le = vec3_from4(l->radiance);
+  if (!LIGHT_IS_RECT(l)) {
+    const vec3 to = vec3_sub(vec3_from4(l->corner), x);
+    const float d2 = vec3_dot(to, to);
+    if (!(d2 > 0.0f)) return vec3_splat(0.0f);
+    return vec3_scale(Le, phase_eval(phase_kind, g, view_dir, vec3_scale(to, 1.0f / nv_sqrt(d2))) / d2);
+  }
+  const vec3 corner = vec3_from4(l->corner), eu = vec3_from4(l->edge_u), ev = vec3_from4(l->edge_v);
+  const vec3 n = vec3_from4(l->normal);
+  const float inv_k = 1.0f / (float)K;
+  float sum = 0.0f;
+  for (int j = 0; j < K; ++j)
+    for (int i = 0; i < K; ++i) {
+      const vec3 q = vec3_add(corner, vec3_add(vec3_scale(eu, ((float)i + 0.5f) * inv_k),
+                                               vec3_scale(ev, ((float)j + 0.5f) * inv_k)));
+      const vec3 to = vec3_sub(q, x);
+      const float d2 = vec3_dot(to, to);
+      if (!(d2 > 0.0f)) continue;
+      const vec3 dir = vec3_scale(to, 1.0f / nv_sqrt(d2));
+      const float cos_l = -vec3_dot(dir, n);
+      if (!(cos_l > 0.0f)) continue;
+      sum += cos_l * phase_eval(phase_kind, g, view_dir, dir) / d2;
+    }
+  return vec3_scale(Le, l->normal.w * inv_k * inv_k * sum);
+}
+
+/* Column density from x to light l, ∫ρ ds over shadow_steps midpoint samples: to the light itself
+ * (a point light; a rectangle with K = 1: its centre), or for a rectangle with K > 1 the effective
+ * column of its K×K points (march_light_phase_sum's): C = −ln(Σ_j w_j e^{−σ̄ C_j} / Σ_j w_j) / σ̄,
+ * w_j = cos θ_j / d_j² (each point's share of the light reaching x), σ̄ the medium's mean σt per
+ * unit density. Why: the path tracer's shadow rays go to every point of the light, and the
+ * transmittance averaged over them is above the transmittance to the centre (e^{−τ} is convex):
+ * through a dense cloud the centre alone makes the light's soft shadow hard and dark. With one σt
+ * for all channels (a grey medium) σt_unit·C gives each channel's averaged transmittance exactly;
+ * for a coloured one it is the average for the mean σt. */
+static inline float march_light_column(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_CONSTANT const light_params* l,
+                                       vec3 x, int K, int shadow_steps, NV_PRIVATE uint* status) {
+  const int area = LIGHT_IS_RECT(l) && K > 1;
+  const vec3 corner = area ? vec3_from4(l->corner) : march_light_position(l);
+  const vec3 eu = vec3_from4(l->edge_u), ev = vec3_from4(l->edge_v), n = vec3_from4(l->normal);
+  const int k_side = area ? K : 1;
+  const float inv_k = 1.0f / (float)k_side;
+  const float sigma = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  float w_sum = 0.0f, loss_sum = 0.0f, column_sum = 0.0f; /* loss: Σ w (e^{−σ̄C} − 1), no cancellation */
+  for (int j = 0; j < k_side; ++j)
+    for (int i = 0; i < k_side; ++i) {
+      const vec3 q = area ? vec3_add(corner, vec3_add(vec3_scale(eu, ((float)i + 0.5f) * inv_k),
+                                                      vec3_scale(ev, ((float)j + 0.5f) * inv_k)))
+                          : corner;
+      const vec3 to = vec3_sub(q, x);
+      const float d2 = vec3_dot(to, to);
+      if (!(d2 > 0.0f)) {
+        if (d2 != d2) *status |= STATUS_NAN;
+        continue;
+      }
+      const float d = nv_sqrt(d2);
+      const vec3 dir = vec3_scale(to, 1.0f / d);
+      const float column = march_column_density(m, GRID_ARG, x, dir, d, shadow_steps, status);
+      if (!area) return column;
+      const float cos_l = -vec3_dot(dir, n);
+      if (!(cos_l > 0.0f)) continue;
+      const float w = cos_l / d2;
+      w_sum += w;
+      loss_sum += w * nv_expm1(-sigma * column);
+      column_sum += w * column;
+    }
+  if (!(w_sum > 0.0f)) return 0.0f; /* nothing of the light faces x (or x is the point light) */
+  /* −ln(1 + mean loss)/σ̄ through expm1 and log1p: a thin column keeps its digits. No extinction, or
+   * every point fully shadowed: the weighted mean column (the limit σ̄ → 0, and as dark as the float
+   * allows otherwise). */
+  const float mean_loss = loss_sum / w_sum;
+  if (!(sigma > 0.0f) || !(mean_loss > -1.0f)) return column_sum / w_sum;
+  return -nv_log1p(mean_loss) / sigma;
 }
 
 /* L_b for the real-time kernels: what the view ray would see with the medium removed, i.e. the

@@ -25,6 +25,17 @@
  * lookup clamps a + g·(b·w_out) at 0 per channel (a truncated expansion can dip below). For an
  * isotropic phase function g = 0 and only R counts.
  *
+ * Interpolation: R is interpolated geometrically, exp(Σ w_k ln R_k) with the trilinear weights
+ * w_k, and the moment per unit R, b/R, linearly. In a dense medium the radiance falls off
+ * exponentially with depth (the Disney cloud at density 10 has a mean free path of a tenth of a
+ * cache cell): a linear mix of a lit node and a node ten mean free paths deeper paints the deeper
+ * one bright, in blocks the shape of the cells (mean ΔE76 6.0 on the Disney cloud against the
+ * path-traced reference); the geometric mean is exact for an exponential along each axis (2.8).
+ * It keeps every property the tests check: equal corners give that value, so the white furnace
+ * stays 1, and for a smooth field it errs, like trilinear, at second order in the node spacing.
+ * A node at 0 would pull the whole cell to 0, so R + floor is interpolated instead, floor =
+ * MS_CACHE_LOG_FLOOR × the cell's largest R, and floor taken off after.
+ *
  * Storage: MS_CACHE_STRIDE floats per node: the running means of the paths so far, R (rgb) then
  * their count, then b for red, green and blue (xyz each, then an unused float); each build launch
  * adds `paths` paths per node (progressive: a viewer refines it over frames), path k of node n
@@ -36,24 +47,44 @@
 #include "shared/node_grid.h"
 
 #define MS_CACHE_STRIDE 16
+/* Interpolation: log(R + floor), floor this fraction of the cell's largest R (a node at 0 then
+ * pulls its neighbours down continuously instead of to 0 at once). */
+#define MS_CACHE_LOG_FLOOR 1e-4f
 
 /* The in-scattered radiance of the rest at index-space point p (inside the box [0, dims]) towards
- * w_out (the propagation direction after scattering), per unit σs: R + g·(b·w_out), trilinear over
- * the nodes, at least 0. */
+ * w_out (the propagation direction after scattering), per unit σs: R·(1 + g·(b/R)·w_out) over the
+ * cell's eight nodes ("Interpolation"), at least 0. */
 static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache, vec3 dims,
                                    vec3 p, float g, vec3 w_out) {
   const node_grid_cell cell = node_grid_locate(c, dims, p);
+  const size_t sy = (size_t)c->nx, sz = (size_t)c->nx * (size_t)c->ny;
+  float w[8];
+  size_t at[8];
+  for (int k = 0; k < 8; ++k) {
+    const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
+    at[k] = ((size_t)cell.base + (size_t)dx + (size_t)dy * sy + (size_t)dz * sz) * (size_t)MS_CACHE_STRIDE;
+    w[k] = (dx ? cell.ax : 1.0f - cell.ax) * (dy ? cell.ay : 1.0f - cell.ay) * (dz ? cell.az : 1.0f - cell.az);
+  }
   float out[3];
   for (int ch = 0; ch < 3; ++ch) {
-    float v = node_grid_interpolate(c, cache + ch, MS_CACHE_STRIDE, cell);
-    if (g != 0.0f) {
-      NV_GLOBAL const float* b = cache + 4 + 4 * ch;
-      const vec3 moment = vec3_make(node_grid_interpolate(c, b, MS_CACHE_STRIDE, cell),
-                                    node_grid_interpolate(c, b + 1, MS_CACHE_STRIDE, cell),
-                                    node_grid_interpolate(c, b + 2, MS_CACHE_STRIDE, cell));
-      v = nv_fmax(0.0f, v + g * vec3_dot(moment, w_out));
+    /* R geometrically ("Interpolation"), the moment per unit R linearly. */
+    float top = 0.0f;
+    for (int k = 0; k < 8; ++k) top = nv_fmax(top, cache[at[k] + (size_t)ch]);
+    if (!(top > 0.0f)) {
+      out[ch] = 0.0f;
+      continue;
     }
-    out[ch] = v;
+    const float floor = MS_CACHE_LOG_FLOOR * top;
+    float log_r = 0.0f;
+    vec3 ratio = vec3_splat(0.0f);
+    for (int k = 0; k < 8; ++k) {
+      NV_GLOBAL const float* node = cache + at[k];
+      const float r = nv_fmax(node[ch], 0.0f) + floor;
+      log_r += w[k] * nv_log(r);
+      ratio = vec3_add(ratio, vec3_scale(vec3_make(node[4 + 4 * ch], node[5 + 4 * ch], node[6 + 4 * ch]), w[k] / r));
+    }
+    const float R = nv_fmax(nv_exp(log_r) - floor, 0.0f);
+    out[ch] = g != 0.0f ? nv_fmax(0.0f, R * (1.0f + g * vec3_dot(ratio, w_out))) : R;
   }
   return vec3_make(out[0], out[1], out[2]);
 }

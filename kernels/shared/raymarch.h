@@ -100,7 +100,24 @@ static inline vec3 raymarch_light_sum(NV_CONSTANT const scene_params* s, NV_CONS
     vec3 dir, I;
     float dist;
     if (!march_light_as_point(&lights[l], x, &dir, &dist, &I)) continue;
-    const vec3 tau = light_cache_optical_depth(m, GRID_ARG, rp, light_cache, l, x, dir, dist, status);
+    const vec3 tau = light_cache_optical_depth(m, GRID_ARG, rp, light_cache, lights, l, x, dir, dist, status);
+    if (rp->area_light_samples > 1) {
+      /* Rectangles as K×K points (march_light_phase_sum), shadowed towards their centre. */
+      const int K = rp->area_light_samples;
+      vec3 lit = vec3_mul(vec3_exp_neg(tau), march_light_phase_sum(&lights[l], x, m->phase, m->g, view_dir, K));
+      float ai = 1.0f, bi = 1.0f, ci = 1.0f;
+      for (int i = 1; i < rp->octaves; ++i) {
+        ai *= rp->octave_a;
+        bi *= rp->octave_b;
+        ci *= rp->octave_c;
+        lit = vec3_add(lit, vec3_scale(vec3_mul(vec3_exp_neg(vec3_scale(tau, bi)),
+                                                march_light_phase_sum(&lights[l], x, m->phase, m->g * ci, view_dir, K)),
+                                       ai));
+      }
+      sum = vec3_add(sum, lit);
+      continue;
+    }
+    /* K = 1: the centre alone, the dissertation's point light, with its arithmetic. */
     /* Octave 0: plain single scattering. */
     vec3 oct = vec3_scale(vec3_exp_neg(tau), phase_eval(m->phase, m->g, view_dir, dir));
     if (rp->octaves > 1) {

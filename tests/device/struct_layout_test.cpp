@@ -55,7 +55,7 @@ TEST(StructLayoutHost, SizesAreMultiplesOf16) {
   EXPECT_EQ(sizeof(camera_params), 96u);
   EXPECT_EQ(sizeof(light_params), 96u);
   EXPECT_EQ(sizeof(node_grid_params), 64u);
-  EXPECT_EQ(sizeof(realtime_params), 176u);
+  EXPECT_EQ(sizeof(realtime_params), 192u);
   EXPECT_EQ(sizeof(majorant_grid_params), 32u);
   EXPECT_EQ(sizeof(medium_params), 144u);
   EXPECT_EQ(sizeof(scene_params), 272u);

@@ -139,7 +139,9 @@ TEST(LightCacheRender, DeviceBuildMatchesTheHost) {
   runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, device.size() * sizeof(float), device.data());
   int positive = 0;
   for (size_t i = 0; i < host.size(); ++i) {
-    ASSERT_NEAR(device[i], host[i], 1e-6 * host[i] + 1e-9) << "value " << i;
+    // A rectangle's column is −log1p(mean of expm1(−σ̄C_j))/σ̄ over its K×K points: OpenCL's expm1
+    // and log1p may differ from libm's by a few ulps, which that quotient carries to ~1e-6 relative.
+    ASSERT_NEAR(device[i], host[i], 1e-5 * host[i] + 1e-9) << "value " << i;
     positive += host[i] > 0;
   }
   EXPECT_GT(positive, int(host.size()) / 4);  // the cloud shadows a good part of the box
