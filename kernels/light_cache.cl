@@ -12,7 +12,7 @@ __kernel void light_cache_build(__constant scene_params* scene, __constant light
   if (node >= nodes) return;
   uint status = 0u;
   cache[(size_t)light * (size_t)nodes + (size_t)node] =
-      light_cache_build_node(&scene->medium, GRID_ARG, c, params->shadow_steps, params->area_light_samples,
+      light_cache_build_node(&scene->medium, GRID_ARG, c, params->shadow_steps, params->shadow_area_samples,
                              &lights[light], node, &status);
   if (status) atomic_or(status_word, status);
 }

@@ -28,7 +28,7 @@ std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view*
   for (int l = 0; l < ds.params.num_lights; ++l)
     for (int n = 0; n < nodes; ++n)
       cache[size_t(l) * size_t(nodes) + size_t(n)] = light_cache_build_node(
-          &ds.params.medium, grid, &c, params.shadow_steps, params.area_light_samples, &ds.lights[size_t(l)], n, &status);
+          &ds.params.medium, grid, &c, params.shadow_steps, params.shadow_area_samples, &ds.lights[size_t(l)], n, &status);
   return cache;
 }
 
@@ -41,7 +41,7 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   // Everything a slab depends on besides its light. The grid is identified by its address: a
   // DeviceSceneBuffers keeps its grid for its life, and a new scene makes a new one.
   const std::string key = rawBytes(dev.scene.params.medium) + rawBytes(dev.scene.grid) + rawBytes(c) +
-                          rawBytes(params.shadow_steps) + rawBytes(params.area_light_samples) + dev.scene.buildOptions +
+                          rawBytes(params.shadow_steps) + rawBytes(params.shadow_area_samples) + dev.scene.buildOptions +
                           rawBytes(numLights);
   const bool all = key != mediumKey_;
   if (all) {

@@ -31,16 +31,17 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   p.depth_factor = r.lobe.depthFactor;
   p.lobe_radius = r.lobe.lobeRadius;
   p.lobe_points = r.lobe.lobePoints;
-  int lobeAreaLightSamples = 1;
+  int lobeShadowAreaSamples = 1;
   switch (r.lobe.variant) {
     case LobeVariant::Eq7: p.lobe_variant = LOBE_EQ7; break;
     case LobeVariant::Corrected:
       p.lobe_variant = LOBE_CORRECTED;
-      lobeAreaLightSamples = 4;
+      lobeShadowAreaSamples = 4;
       break;
   }
-  if (r.lobe.areaLightSamples > 0) lobeAreaLightSamples = r.lobe.areaLightSamples;
-  p.area_light_samples = lobe ? lobeAreaLightSamples : r.raymarch.areaLightSamples;
+  if (r.lobe.shadowAreaSamples > 0) lobeShadowAreaSamples = r.lobe.shadowAreaSamples;
+  p.area_light_samples = lobe ? r.lobe.areaLightSamples : r.raymarch.areaLightSamples;
+  p.shadow_area_samples = lobe ? lobeShadowAreaSamples : r.raymarch.shadowAreaSamples;
   p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
   if (!lobe && r.raymarch.multipleScattering == MultipleScattering::Cache)
     p.ms_cache = nodeGridLayout(ds, r.raymarch.msCache.resolution);

@@ -95,8 +95,11 @@ struct RaymarchSettings {
   MultipleScattering multipleScattering = MultipleScattering::None;
   MsCacheSettings msCache;
   // A rectangle light is K×K points for the phase function and 1/d² (march_light_phase_sum in
-  // kernels/shared/march.h); 1 = its centre, the dissertation's point approximation.
-  int areaLightSamples = 4;
+  // kernels/shared/march.h), costing K² phase evaluations per sample; 1 = its centre, the
+  // dissertation's point approximation. Its shadow is averaged over K×K points
+  // (march_light_column), which costs only the light cache's build.
+  int areaLightSamples = 1;
+  int shadowAreaSamples = 4;
 };
 
 // The Lobe Estimator: the dissertation's Eq. 7, or the corrected estimator (kernels/shared/lobe.h).
@@ -111,7 +114,8 @@ struct LobeSettings {
   int firstHitSteps = 60;        // samples of the first-hit search (then 6 bisections)
   int viewSteps = 24;            // samples of each transmittance from the first hit to a lobe point
   float minTransmittance = 1e-3f;  // those transmittances stop below it (lobe.h: error < it · L_b)
-  int areaLightSamples = 0;        // K as for the ray marcher; 0 = the variant's: eq7 1, corrected 4
+  int areaLightSamples = 1;        // as the ray marcher's
+  int shadowAreaSamples = 0;       // as the ray marcher's; 0 = the variant's: eq7 1, corrected 4
 };
 
 // The light-transmittance cache of the real-time kernels (kernels/shared/light_cache.h).

@@ -56,8 +56,10 @@
 // |   raymarch.octaveScattering, .octaveExtinction, .octavePhase (a, b, c) | number | | 0.5 | [0, 1], a <= b   |
 // |   raymarch.minTransmittance | number: view march stops   |     | 0.001       | [0, 1); 0 = never          |
 // |   raymarch.multipleScattering | none, octaves, cache      |     | none        | octaves when octaves > 1   |
-// |   raymarch.areaLightSamples | integer: K×K points per     |     | 4           | [1, 16]; 1 = the centre    |
-// |                         | rectangle light                 |     |             |                            |
+// |   raymarch.areaLightSamples | integer: K×K points per     |     | 1           | [1, 16]; 1 = the centre    |
+// |                         | rectangle light (phase, 1/d²)   |     |             |                            |
+// |   raymarch.shadowAreaSamples | integer: K×K points per    |     | 4           | [1, 16]; 1 = the centre    |
+// |                         | rectangle light (shadow)        |     |             |                            |
 // |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]                   |
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
 // |   lobe.variant          | eq7, corrected (lobe.h)         |     | eq7         |                            |
@@ -70,7 +72,8 @@
 // |   lobe.viewSteps        | integer: Tr(x0 -> P_i) samples; |     | 24          | >= 1                       |
 // |                         | corrected: the one view march   |     |             |                            |
 // |   lobe.minTransmittance | number: Tr(x0 -> P_i) stops     |     | 0.001       | [0, 1); 0 = never          |
-// |   lobe.areaLightSamples | integer, as raymarch's          |     | eq7 1,      | [1, 16]                    |
+// |   lobe.areaLightSamples | integer, as raymarch's          |     | 1           | [1, 16]                    |
+// |   lobe.shadowAreaSamples | integer, as raymarch's         |     | eq7 1,      | [1, 16]                    |
 // |                         |                                 |     | corrected 4 |                            |
 // |   lightCache.resolution | "auto" or integer: cells on the |     | auto        | [0, 1024]; 0 = off (exact  |
 // |                         | box's longest axis              |     |             | shadow marches)            |
@@ -347,6 +350,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
                                                 ") or the octaves add energy");
     s.raymarch.minTransmittance = readMinTransmittance(m, s.raymarch.minTransmittance);
     s.raymarch.areaLightSamples = readInt(m, "areaLightSamples", s.raymarch.areaLightSamples, 1, 16);
+    s.raymarch.shadowAreaSamples = readInt(m, "shadowAreaSamples", s.raymarch.shadowAreaSamples, 1, 16);
     s.raymarch.multipleScattering =
         readEnum(m, "multipleScattering", kMultipleScattering,
                  s.raymarch.octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::None);
@@ -371,7 +375,8 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
     s.lobe.firstHitSteps = readInt(l, "firstHitSteps", s.lobe.firstHitSteps, 1);
     s.lobe.viewSteps = readInt(l, "viewSteps", s.lobe.viewSteps, 1);
     s.lobe.minTransmittance = readMinTransmittance(l, s.lobe.minTransmittance);
-    if (l.find("areaLightSamples")) s.lobe.areaLightSamples = readInt(l, "areaLightSamples", 1, 1, 16);
+    s.lobe.areaLightSamples = readInt(l, "areaLightSamples", s.lobe.areaLightSamples, 1, 16);
+    if (l.find("shadowAreaSamples")) s.lobe.shadowAreaSamples = readInt(l, "shadowAreaSamples", 1, 1, 16);
     l.reportUnknown();
   }
   if (const json* v = r.find("lightCache")) {

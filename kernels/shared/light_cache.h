@@ -2,7 +2,7 @@
  * caches"; the per-light "shadow volume" production engines keep, e.g. Hillaire 2016, Frostbite's
  * volumetric shadow maps). Per light, a grid of nodes over the medium's box holding what every
  * shadow ray of raymarch.h and lobe.h would otherwise march: the column density from the node to
- * the light (march_light_column: a point light; a rectangle's centre, or with area_light_samples
+ * the light (march_light_column: a point light; a rectangle's centre, or with shadow_area_samples
  * K > 1 its effective column over K×K points of its area).
  *
  * Layout: a node grid over the medium's box (node_grid.h, realtime_params.light_cache), one slab
@@ -76,9 +76,9 @@ static inline vec3 light_cache_optical_depth(NV_CONSTANT const medium_params* m,
   const vec3 sigma_t_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
   if (rp->light_cache.nx > 0)
     return vec3_scale(sigma_t_unit, light_cache_column(m, &rp->light_cache, cache, light, x, dir, dist, status));
-  if (rp->area_light_samples > 1 && LIGHT_IS_RECT(&lights[light])) /* the columns the cache would hold */
+  if (rp->shadow_area_samples > 1 && LIGHT_IS_RECT(&lights[light])) /* the columns the cache would hold */
     return vec3_scale(sigma_t_unit,
-                      march_light_column(m, GRID_ARG, &lights[light], x, rp->area_light_samples, rp->shadow_steps,
+                      march_light_column(m, GRID_ARG, &lights[light], x, rp->shadow_area_samples, rp->shadow_steps,
                                          status));
   return march_optical_depth(m, GRID_ARG, x, dir, dist, rp->shadow_steps, status);
 }

@@ -37,7 +37,10 @@
  * MS_CACHE_LOG_FLOOR × the cell's largest R, and floor taken off after.
  *
  * Storage: MS_CACHE_STRIDE floats per node: the running means of the paths so far, R (rgb) then
- * their count, then b for red, green and blue (xyz each, then an unused float); each build launch
+ * their count, then b for red, green and blue (xyz each, then an unused float); then what the
+ * lookup reads, derived from them by the build after each launch: ln R (rgb, at MS_CACHE_LOG_R)
+ * and b/R (at MS_CACHE_RATIO), so that a lookup takes no logarithm or division per corner (the
+ * ray marcher makes one lookup per sample); each build launch
  * adds `paths` paths per node (progressive: a viewer refines it over frames), path k of node n
  * drawing its random numbers from its own counter-based stream (seed, n, k), so the cache after K
  * paths is the same whatever the launches it was split into (ms_cache_build.h). */
@@ -46,7 +49,9 @@
 
 #include "shared/node_grid.h"
 
-#define MS_CACHE_STRIDE 16
+#define MS_CACHE_STRIDE 32
+#define MS_CACHE_LOG_R 16 /* ln R per channel (−∞ where R = 0), written by the build */
+#define MS_CACHE_RATIO 20 /* b/R per channel (xyz each; 0 where R = 0), written by the build */
 /* Interpolation: log(R + floor), floor this fraction of the cell's largest R (a node at 0 then
  * pulls its neighbours down continuously instead of to 0 at once). */
 #define MS_CACHE_LOG_FLOOR 1e-4f
@@ -67,7 +72,23 @@ static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLO
   }
   float out[3];
   for (int ch = 0; ch < 3; ++ch) {
-    /* R geometrically ("Interpolation"), the moment per unit R linearly. */
+    /* R geometrically ("Interpolation"), the moment per unit R linearly; from the node's ln R and
+     * b/R when every corner has R > 0 (the build stores them: no log or division here). */
+    int all_lit = 1;
+    for (int k = 0; k < 8; ++k) all_lit &= cache[at[k] + MS_CACHE_LOG_R + (size_t)ch] > -NV_INFINITY;
+    if (all_lit) {
+      float log_r = 0.0f;
+      vec3 ratio = vec3_splat(0.0f);
+      for (int k = 0; k < 8; ++k) {
+        NV_GLOBAL const float* q = cache + at[k] + MS_CACHE_RATIO + 3 * ch;
+        log_r += w[k] * cache[at[k] + MS_CACHE_LOG_R + (size_t)ch];
+        ratio = vec3_add(ratio, vec3_scale(vec3_make(q[0], q[1], q[2]), w[k]));
+      }
+      const float R = nv_exp(log_r);
+      out[ch] = g != 0.0f ? nv_fmax(0.0f, R * (1.0f + g * vec3_dot(ratio, w_out))) : R;
+      continue;
+    }
+    /* A corner at 0: R + floor, from the running means. */
     float top = 0.0f;
     for (int k = 0; k < 8; ++k) top = nv_fmax(top, cache[at[k] + (size_t)ch]);
     if (!(top > 0.0f)) {

@@ -29,7 +29,7 @@ static inline vec3 ms_cache_path(NV_CONSTANT const scene_params* s, NV_CONSTANT 
 }
 
 /* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"):
- * v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch. */
+ * v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then ln R and b/R. */
 static inline void ms_cache_refine_node(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
                                         GRID_PARAM, NV_CONSTANT const node_grid_params* c, int node,
                                         NV_GLOBAL float* v, uint first, uint count, NV_PRIVATE uint* status) {
@@ -44,6 +44,12 @@ static inline void ms_cache_refine_node(NV_CONSTANT const scene_params* s, NV_CO
       for (int a = 0; a < 3; ++a) v[4 + 4 * ch + a] += (Lc[ch] * w[a] - v[4 + 4 * ch + a]) / n;
     }
     v[3] = n;
+  }
+  /* What the lookup reads (ms_cache.h, "Storage"). */
+  for (int ch = 0; ch < 3; ++ch) {
+    const float R = v[ch];
+    v[MS_CACHE_LOG_R + ch] = R > 0.0f ? nv_log(R) : -NV_INFINITY;
+    for (int a = 0; a < 3; ++a) v[MS_CACHE_RATIO + 3 * ch + a] = R > 0.0f ? v[4 + 4 * ch + a] / R : 0.0f;
   }
 }
 

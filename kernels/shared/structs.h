@@ -106,8 +106,9 @@ typedef struct realtime_params {
   int lobe_variant;     /* lobe: LOBE_EQ7 or LOBE_CORRECTED (lobe.h) */
   node_grid_params light_cache; /* the light-transmittance cache (light_cache.h); nx = 0: off */
   node_grid_params ms_cache;    /* raymarch: the multiple-scattering cache (ms_cache.h); nx = 0: off */
-  int area_light_samples; /* K: a rectangle light is K×K points (march_light_phase_sum); 1 = its centre */
-  int pad1, pad2, pad3;
+  int area_light_samples;   /* K: a rectangle is K×K points for the phase and 1/d² (march_light_phase_sum) */
+  int shadow_area_samples;  /* K: a rectangle's shadow averaged over K×K points (march_light_column) */
+  int pad2, pad3;
 } realtime_params;
 
 typedef struct scene_params {
