@@ -92,7 +92,7 @@ METHODS = {
                        "base": {"msCache.resolution": 16, "msCache.paths": 256},
                        "style": ("triangle-down", "#e7298a")},
     "lobe-eq7": {"algorithm": "lobe", "settings": {"variant": "eq7"}, "base": {}, "style": ("triangle", "#1b9e77")},
-    "lobe-corrected": {"algorithm": "lobe", "settings": {"variant": "corrected"}, "base": {},
+    "lobe-corrected": {"algorithm": "lobe", "settings": {"variant": "corrected"}, "base": {"viewSteps": 16},
                        "style": ("cross", "#7570b3")},
 }
 
@@ -101,9 +101,10 @@ FULL_SWEEPS = {
     "pathtrace": {"spp": [1, 4, 16, 64, 256], "bounces": [1, 2, 4, 8]},
     "raymarch-none": {"steps": [15, 30, 60, 120], "shadowSteps": [5, 10, 20]},
     "raymarch-octaves": {"octaves": [2, 4, 8], "steps": [30, 60, 120]},
-    "raymarch-cache": {"msCache.resolution": [8, 16, 32], "msCache.paths": [64, 256, 1024], "steps": [30, 60, 120]},
+    "raymarch-cache": {"msCache.resolution": [8, 16, 32], "msCache.paths": [64, 256, 1024], "steps": [30, 60, 120],
+                       "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
-    "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [12, 24, 48]},
+    "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32]},
 }
 QUICK_SWEEPS = {
     "pathtrace": {"spp": [1, 16], "bounces": [1, 4]},
@@ -111,12 +112,13 @@ QUICK_SWEEPS = {
     "raymarch-octaves": {"octaves": [2, 4], "steps": [30, 60]},
     "raymarch-cache": {"msCache.resolution": [8, 16], "msCache.paths": [64, 256], "steps": [30, 60]},
     "lobe-eq7": {"lobePoints": [10, 30], "depthFactor": [5, 100], "shadowSteps": [25, 100]},
-    "lobe-corrected": {"lobePoints": [10, 30], "lobeRadius": [0.3, 3], "viewSteps": [12, 24]},
+    "lobe-corrected": {"lobePoints": [10, 30], "lobeRadius": [0.3, 3], "viewSteps": [8, 16]},
 }
 # narval's defaults when the scene does not set renderer.raymarch / renderer.lobe (README,
 # host/scene/scene_load.cpp); dotted names are nested objects (renderer.raymarch.msCache.resolution).
 REALTIME_DEFAULTS = {
-    "raymarch": {"steps": 60, "shadowSteps": 10, "octaves": 1, "msCache.resolution": 16, "msCache.paths": 256},
+    "raymarch": {"steps": 60, "shadowSteps": 10, "octaves": 1, "msCache.resolution": 16, "msCache.paths": 256,
+                 "shadowAreaSamples": 4, "areaLightSamples": 1},
     "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24},
 }
 

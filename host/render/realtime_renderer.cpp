@@ -22,7 +22,6 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   realtime_params p{};
   p.steps = lobe ? r.lobe.firstHitSteps : r.raymarch.steps;
   p.shadow_steps = lobe ? r.lobe.shadowSteps : r.raymarch.shadowSteps;
-  p.view_steps = r.lobe.viewSteps;
   p.min_transmittance = lobe ? r.lobe.minTransmittance : r.raymarch.minTransmittance;
   p.octaves = r.raymarch.multipleScattering == MultipleScattering::Octaves ? r.raymarch.octaves : 1;
   p.octave_a = r.raymarch.octaveScattering;
@@ -31,15 +30,19 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   p.depth_factor = r.lobe.depthFactor;
   p.lobe_radius = r.lobe.lobeRadius;
   p.lobe_points = r.lobe.lobePoints;
-  int lobeShadowAreaSamples = 1;
+  // The variants' defaults where the scene leaves the key out (0): eq7 the dissertation's.
+  int lobeShadowAreaSamples = 1, lobeViewSteps = 24;
   switch (r.lobe.variant) {
     case LobeVariant::Eq7: p.lobe_variant = LOBE_EQ7; break;
     case LobeVariant::Corrected:
       p.lobe_variant = LOBE_CORRECTED;
       lobeShadowAreaSamples = 4;
+      lobeViewSteps = 16;
       break;
   }
   if (r.lobe.shadowAreaSamples > 0) lobeShadowAreaSamples = r.lobe.shadowAreaSamples;
+  if (r.lobe.viewSteps > 0) lobeViewSteps = r.lobe.viewSteps;
+  p.view_steps = lobeViewSteps;
   p.area_light_samples = lobe ? r.lobe.areaLightSamples : r.raymarch.areaLightSamples;
   p.shadow_area_samples = lobe ? lobeShadowAreaSamples : r.raymarch.shadowAreaSamples;
   p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);

@@ -112,7 +112,8 @@ struct LobeSettings {
   float lobeRadius = 1.0f;       // eq7: world units; corrected: mean free paths of unit density
   int shadowSteps = 100;
   int firstHitSteps = 60;        // samples of the first-hit search (then 6 bisections)
-  int viewSteps = 24;            // samples of each transmittance from the first hit to a lobe point
+  int viewSteps = 0;             // samples of each transmittance from the first hit to a lobe point
+                                 // (corrected: of its one view march); 0 = the variant's: eq7 24, corrected 16
   float minTransmittance = 1e-3f;  // those transmittances stop below it (lobe.h: error < it · L_b)
   int areaLightSamples = 1;        // as the ray marcher's
   int shadowAreaSamples = 0;       // as the ray marcher's; 0 = the variant's: eq7 1, corrected 4

@@ -69,8 +69,8 @@
 // |                         | corrected mean free paths       |     |             |                            |
 // |   lobe.shadowSteps      | integer                         |     | 100         | >= 1                       |
 // |   lobe.firstHitSteps    | integer (eq7)                   |     | 60          | >= 1                       |
-// |   lobe.viewSteps        | integer: Tr(x0 -> P_i) samples; |     | 24          | >= 1                       |
-// |                         | corrected: the one view march   |     |             |                            |
+// |   lobe.viewSteps        | integer: Tr(x0 -> P_i) samples; |     | eq7 24,     | >= 1                       |
+// |                         | corrected: the one view march   |     | corrected 16|                            |
 // |   lobe.minTransmittance | number: Tr(x0 -> P_i) stops     |     | 0.001       | [0, 1); 0 = never          |
 // |   lobe.areaLightSamples | integer, as raymarch's          |     | 1           | [1, 16]                    |
 // |   lobe.shadowAreaSamples | integer, as raymarch's         |     | eq7 1,      | [1, 16]                    |
@@ -373,7 +373,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
     s.lobe.lobeRadius = readNonNegative(l, "lobeRadius", s.lobe.lobeRadius);
     s.lobe.shadowSteps = readInt(l, "shadowSteps", s.lobe.shadowSteps, 1);
     s.lobe.firstHitSteps = readInt(l, "firstHitSteps", s.lobe.firstHitSteps, 1);
-    s.lobe.viewSteps = readInt(l, "viewSteps", s.lobe.viewSteps, 1);
+    if (l.find("viewSteps")) s.lobe.viewSteps = readInt(l, "viewSteps", 1, 1);
     s.lobe.minTransmittance = readMinTransmittance(l, s.lobe.minTransmittance);
     s.lobe.areaLightSamples = readInt(l, "areaLightSamples", s.lobe.areaLightSamples, 1, 16);
     if (l.find("shadowAreaSamples")) s.lobe.shadowAreaSamples = readInt(l, "shadowAreaSamples", 1, 1, 16);
