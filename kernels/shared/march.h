@@ -171,6 +171,13 @@ static inline int march_light_as_point(NV_CONSTANT const light_params* l, vec3 x
   return 1;
 }
 
+/* Point (i, j) of a rectangle's K×K split: the centre of that sub-rectangle. */
+static inline vec3 march_light_area_point(NV_CONSTANT const light_params* l, int i, int j, int K) {
+  const float inv_k = 1.0f / (float)K;
+  return vec3_add(vec3_from4(l->corner), vec3_add(vec3_scale(vec3_from4(l->edge_u), ((float)i + 0.5f) * inv_k),
+                                                  vec3_scale(vec3_from4(l->edge_v), ((float)j + 0.5f) * inv_k)));
+}
+
 /* Light l's unshadowed in-scattering at x per unit σs, Σ_j I_j·p(g, view_dir·dir_j)/d_j² (view_dir
  * the propagation direction before scattering, e.g. away from the camera): a point light is itself;
  * a rectangle is K×K points at the centres of a K×K split of its area, each with intensity
@@ -189,15 +196,12 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
     if (!(d2 > 0.0f)) return vec3_splat(0.0f);
     return vec3_scale(Le, phase_eval(phase_kind, g, view_dir, vec3_scale(to, 1.0f / nv_sqrt(d2))) / d2);
   }
-  const vec3 corner = vec3_from4(l->corner), eu = vec3_from4(l->edge_u), ev = vec3_from4(l->edge_v);
   const vec3 n = vec3_from4(l->normal);
   const float inv_k = 1.0f / (float)K;
   float sum = 0.0f;
   for (int j = 0; j < K; ++j)
     for (int i = 0; i < K; ++i) {
-      const vec3 q = vec3_add(corner, vec3_add(vec3_scale(eu, ((float)i + 0.5f) * inv_k),
-                                               vec3_scale(ev, ((float)j + 0.5f) * inv_k)));
-      const vec3 to = vec3_sub(q, x);
+      const vec3 to = vec3_sub(march_light_area_point(l, i, j, K), x);
       const float d2 = vec3_dot(to, to);
       if (!(d2 > 0.0f)) continue;
       const vec3 dir = vec3_scale(to, 1.0f / nv_sqrt(d2));
@@ -220,18 +224,13 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
 static inline float march_light_column(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_CONSTANT const light_params* l,
                                        vec3 x, int K, int shadow_steps, NV_PRIVATE uint* status) {
   const int area = LIGHT_IS_RECT(l) && K > 1;
-  const vec3 corner = area ? vec3_from4(l->corner) : march_light_position(l);
-  const vec3 eu = vec3_from4(l->edge_u), ev = vec3_from4(l->edge_v), n = vec3_from4(l->normal);
+  const vec3 n = vec3_from4(l->normal);
   const int k_side = area ? K : 1;
-  const float inv_k = 1.0f / (float)k_side;
   const float sigma = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
   float w_sum = 0.0f, loss_sum = 0.0f, column_sum = 0.0f; /* loss: Σ w (e^{−σ̄C} − 1), no cancellation */
   for (int j = 0; j < k_side; ++j)
     for (int i = 0; i < k_side; ++i) {
-      const vec3 q = area ? vec3_add(corner, vec3_add(vec3_scale(eu, ((float)i + 0.5f) * inv_k),
-                                                      vec3_scale(ev, ((float)j + 0.5f) * inv_k)))
-                          : corner;
-      const vec3 to = vec3_sub(q, x);
+      const vec3 to = vec3_sub(area ? march_light_area_point(l, i, j, K) : march_light_position(l), x);
       const float d2 = vec3_dot(to, to);
       if (!(d2 > 0.0f)) {
         if (d2 != d2) *status |= STATUS_NAN;

@@ -39,11 +39,12 @@ inline RenderResult renderAlgorithm(const Scene& scene, const DenseGrid* grid = 
   return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
 }
 
-// What the hard-case suites render: every algorithm, and the ray marcher with its
-// multiple-scattering cache ("raymarch+ms-cache": a small one, 4 cells and 8 paths per node, so the
-// suites stay fast; every code path of the cache's build and lookup runs).
-inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "raymarch+ms-cache", "lobe",
-                                                 "lobe+corrected"};
+// What the hard-case suites render: every algorithm and every real-time option: the ray marcher
+// with octaves, with its multiple-scattering cache ("raymarch+ms-cache": a small one, 4 cells and 8
+// paths per node, so the suites stay fast; every code path of the cache's build and lookup runs;
+// with 2x2 phase points per rectangle light) and the corrected Lobe Estimator.
+inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "raymarch+octaves", "raymarch+ms-cache",
+                                                 "lobe", "lobe+corrected"};
 
 // `scene` rendered by one of kHardCaseRenderers (or any algorithm name), one frame for the
 // real-time ones.
@@ -53,6 +54,11 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, const D
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
     scene.renderer.raymarch.msCache.resolution = 4;
     scene.renderer.raymarch.msCache.paths = 8;
+    scene.renderer.raymarch.areaLightSamples = 2;  // and the phase over a rectangle's area
+  } else if (renderer == "raymarch+octaves") {
+    scene.renderer.algorithm = "raymarch";
+    scene.renderer.raymarch.multipleScattering = MultipleScattering::Octaves;
+    scene.renderer.raymarch.octaves = 3;
   } else if (renderer == "lobe+corrected") {
     scene.renderer.algorithm = "lobe";
     scene.renderer.lobe.variant = LobeVariant::Corrected;
