@@ -71,13 +71,15 @@
  *     camera unscattered (Eq. 7's mean Tr(x0 → P_i) counts light that the lobe points see, not the
  *     camera; dropping it also drops its n view marches). One march of view_steps samples over the
  *     occupied cells gives T_v.
- * C2. The centre: the same march gives the expected depth of the view ray's first interaction,
- *     t_c = ∫ t σt T dt / ∫ σt T dt (midpoint rule, channel mean): where the light S stands for
- *     is scattered to the camera. Eq. 7's depth_factor/σ̄t measures depth with unit density, so
- *     in a thin wisp or a dense core c lands where nothing scatters (the black core and white ring
- *     on the default cloud). t_c lies between the entry and the last sample with density (it is a
- *     weighted mean of sample positions), inside the box; first-hit search and depth_factor are
- *     not used. Early termination as in step 4: the march stops once every channel's τ exceeds
+ * C2. The centre: the same march gives where along the view ray the camera's light is scattered,
+ *     t_c = ∫ t σt T S dt / ∫ σt T S dt (midpoint rule, channel means), S the lights' in-scattering
+ *     at t (one light-cache lookup per sample); where no light reaches the ray, the expected depth
+ *     of its first interaction, ∫ t σt T dt / ∫ σt T dt. Eq. 7's depth_factor/σ̄t measures depth
+ *     with unit density, so in a thin wisp or a dense core c lands where nothing scatters (the
+ *     black core and white ring on the default cloud); weighting by S as well matters where the
+ *     light comes from behind (back-lit Disney cloud: JND 17.2% → 15.9% against a 256-spp
+ *     reference). t_c lies between the entry and the last sample with density (a weighted mean of
+ *     sample positions), inside the box; first-hit search and depth_factor are not used. Early termination as in step 4: the march stops once every channel's τ exceeds
  *     −ln ε'; the samples left carry weight below ε' together, so 1 − T_v is off by less than ε'
  *     (relative error of the in-scattered term below ε'/(1 − ε')).
  * C3. Scale: lobe_radius is in mean free paths of unit density, r = lobe_radius/σ̄t. Scaling the
@@ -173,9 +175,9 @@ static inline void lobe_add_inscattered(NV_CONSTANT const scene_params* s, NV_CO
     vec3 to_light, I;
     float dist;
     if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
-    if (p->area_light_samples > 1) {
-      /* Rectangles as K×K points (march_light_phase_sum), shadowed towards their centre. */
-      const vec3 tr = vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, lights, k, P, to_light, dist, status));
+    const vec3 tr =
+        vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, lights, k, P, to_light, dist, status));
+    if (p->area_light_samples > 1) { /* rectangles as K×K points (march_light_phase_sum) */
       *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase_sum(&lights[k], P, m->phase, m->g, d,
                                                                       p->area_light_samples)));
       continue;
@@ -186,7 +188,6 @@ static inline void lobe_add_inscattered(NV_CONSTANT const scene_params* s, NV_CO
       if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
       continue;
     }
-    const vec3 tr = vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, lights, k, P, to_light, dist, status));
     *in_sum = vec3_add(*in_sum, vec3_scale(vec3_mul(tr, I), f / (dist * dist)));
   }
 }
@@ -248,8 +249,9 @@ static inline vec3 lobe_radiance_corrected(NV_CONSTANT const scene_params* s, NV
                                            vec3 origin, vec3 dir, vec3 tx, vec3 ty, vec3 Lb,
                                            NV_PRIVATE const medium_segment* seg, NV_PRIVATE uint* status) {
   NV_CONSTANT const medium_params* m = &s->medium;
-  /* C1. One march of the view ray: its transmittance T_v and the expected depth of its first
-   * interaction, t_c = Σ w_k t_k / Σ w_k with w_k = T(before k)·(1 − e^{−σ̄t,k Δ}) (channel mean). */
+  /* C1-C2. One march of the view ray: its transmittance T_v and where its light is scattered,
+   * t_c = Σ w_k S_k t_k / Σ w_k S_k with w_k = T(before k)·(1 − e^{−σ̄t,k Δ}) (channel means) and
+   * S_k the lights' in-scattering at sample k (Σ w_k t_k / Σ w_k where no light reaches the ray). */
   const float tau_limit = p->min_transmittance > 0.0f
                               ? -nv_log(p->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
                               : NV_INFINITY;
@@ -277,7 +279,7 @@ static inline vec3 lobe_radiance_corrected(NV_CONSTANT const scene_params* s, NV
   const vec3 Tv = vec3_exp_neg(tau);
   const vec3 c = vec3_madd(origin, dir, ws_sum > 0.0f ? wst_sum / ws_sum : wt_sum / w_sum);
 
-  /* C2-C3. Lobe points at r = lobe_radius mean free paths of unit density, each pulled in to the
+  /* C3-C4. Lobe points at r = lobe_radius mean free paths of unit density, each pulled in to the
    * box's boundary along its own direction. */
   const float r = p->lobe_radius / vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
   const int n = p->lobe_points;
@@ -290,7 +292,7 @@ static inline vec3 lobe_radiance_corrected(NV_CONSTANT const scene_params* s, NV
   }
   const float fn = (float)n;
   const vec3 in_mean = vec3_make(in_sum.x / fn, in_sum.y / fn, in_sum.z / fn);
-  /* C4. L = L_b·T_v + (1 − T_v)·albedo·S̄. */
+  /* L = L_b·T_v + (1 − T_v)·albedo·S̄ (C1). */
   const vec3 opacity = vec3_sub(vec3_splat(1.0f), Tv);
   return vec3_add(vec3_mul(Lb, Tv), vec3_mul(vec3_mul(opacity, lobe_albedo(m)), in_mean));
 }
