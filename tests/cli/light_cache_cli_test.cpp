@@ -113,6 +113,11 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.multipleScattering: unknown value \"fog\" (allowed: none, octaves, cache)\n"},
       {"renderer.raymarch.msCache.resolution=0",
        "narval: s.json: renderer.raymarch.msCache.resolution: must be at least 1, got 0\n"},
+      {"renderer.raymarch.shadowAreaSamples=0",
+       "narval: s.json: renderer.raymarch.shadowAreaSamples: must be at least 1, got 0\n"},
+      {"renderer.raymarch.areaLightSamples=17",
+       "narval: s.json: renderer.raymarch.areaLightSamples: must be at most 16, got 17\n"},
+      {"renderer.lobe.shadowAreaSamples=0", "narval: s.json: renderer.lobe.shadowAreaSamples: must be at least 1, got 0\n"},
       {"renderer.lobe.variant=\\\"eq8\\\"",
        "narval: s.json: renderer.lobe.variant: unknown value \"eq8\" (allowed: eq7, corrected)\n"},
   };
