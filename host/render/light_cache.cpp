@@ -27,8 +27,9 @@ std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view*
   uint32_t status = 0;
   for (int l = 0; l < ds.params.num_lights; ++l)
     for (int n = 0; n < nodes; ++n)
-      cache[size_t(l) * size_t(nodes) + size_t(n)] = light_cache_build_node(
-          &ds.params.medium, grid, &c, params.shadow_steps, params.shadow_area_samples, &ds.lights[size_t(l)], n, &status);
+      cache[size_t(l) * size_t(nodes) + size_t(n)] =
+          light_cache_build_node(&ds.params.medium, grid, &c, params.shadow_steps, params.shadow_area_samples,
+                                 &ds.lights[size_t(l)], n, &status);
   return cache;
 }
 

@@ -368,6 +368,10 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
   if (const json* v = r.find("lobe")) {
     ObjectReader l(ctx, *v, r.keyOf("lobe"));
     s.lobe.variant = readEnum(l, "variant", kLobeVariants, s.lobe.variant);
+    // The corrected estimator has no first-hit search and no fixed depth (lobe.h, C2).
+    if (s.lobe.variant == LobeVariant::Corrected)
+      for (const char* key : {"depthFactor", "firstHitSteps"})
+        if (l.find(key)) ctx.warn(l.keyOf(key), "applies to variant \"eq7\"; \"corrected\" ignores it");
     s.lobe.depthFactor = readNonNegative(l, "depthFactor", s.lobe.depthFactor);
     s.lobe.lobePoints = readInt(l, "lobePoints", s.lobe.lobePoints, 1);
     s.lobe.lobeRadius = readNonNegative(l, "lobeRadius", s.lobe.lobeRadius);

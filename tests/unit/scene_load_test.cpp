@@ -439,6 +439,19 @@ TEST(SceneWarnings, NoLightAndBlackBackground) {
   EXPECT_TRUE(parseScene(j.dump(), "s.json").warnings.empty());
 }
 
+// The corrected Lobe Estimator has no first-hit search and no fixed depth: those keys are named as
+// ignored under it, and not under eq7 (where they count).
+TEST(SceneWarnings, EqSevenKeysUnderTheCorrectedLobe) {
+  json j = minimalScene();
+  j["renderer"]["lobe"] = {{"variant", "corrected"}, {"depthFactor", 5}, {"firstHitSteps", 30}, {"lobeRadius", 2}};
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
+            (std::vector<std::string>{
+                "s.json: renderer.lobe.depthFactor: applies to variant \"eq7\"; \"corrected\" ignores it",
+                "s.json: renderer.lobe.firstHitSteps: applies to variant \"eq7\"; \"corrected\" ignores it"}));
+  j["renderer"]["lobe"]["variant"] = "eq7";
+  EXPECT_TRUE(parseScene(j.dump(), "s.json").warnings.empty());
+}
+
 // ---------------------------------------------------------------- --set overrides
 
 TEST(SceneOverrides, ReplaceCreateAndParseValues) {
