@@ -2,7 +2,8 @@
 # bench/device/gpu_bench.sh [OUTDIR]: on the GPU machine (after `source bench/device/setup.sh`):
 # the three shipped scenes at 1200x600, path tracing 256 spp per grid storage and majorant, and
 # 20 frames of raymarch and lobe per storage; prints a Markdown table; then bench/realtime_frames.sh
-# at 1280x720. Not a test.
+# at 1280x720, and bench/speed_vs_error.py at 1280x720 (every real-time option against 2048-spp
+# references rendered there). Not a test.
 set -u
 cd "$(dirname "$0")/../.."
 N=$PWD/build/narval
@@ -36,3 +37,8 @@ PY
 # The real-time kernels at 1280x720 with the light-transmittance cache off and on, on the four
 # shipped scenes (the 2 ms per frame GPU budget; no path-traced references here).
 bench/realtime_frames.sh --resolutions 1280x720 --ref-resolutions "" --frames 20 --out "$out/realtime"
+# Every real-time option against path-traced references at 1280x720 (the 16 ms targets): the
+# references (2048 spp) are rendered on the GPU too, into a cache beside the output, then the
+# methods' sweeps; the report and its budget picks land in $out/speed_vs_error.
+NARVAL_CACHE_DIR="$out/cache" python3 bench/speed_vs_error.py --resolution 1280x720 --frames 20 \
+  --out "$out/speed_vs_error" || echo "failed: speed_vs_error" >&2
