@@ -61,8 +61,7 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
     if (all || std::memcmp(&lights_[size_t(l)], &dev.scene.lights[size_t(l)], sizeof(light_params)) != 0)
       stale.push_back(l);
   if (stale.empty()) return;
-  paramBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(params),
-                         const_cast<realtime_params*>(&params));
+  paramBuf_ = constantBuffer(rt, params);
   rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
   dev.bind(kernel_);
   const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;

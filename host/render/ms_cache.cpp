@@ -29,7 +29,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
     rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
     program_ = buildProgram(rt, "ms_cache.cl", dev.scene.buildOptions);
     kernel_ = cl::Kernel(program_, "ms_cache_build");
-    sceneBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof pathScene, &pathScene);
+    sceneBuf_ = constantBuffer(rt, pathScene);
     statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
     rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
     paths_ = 0;
@@ -37,8 +37,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
     key_ = key;
   }
   if (paths_ >= targetPaths) return;
-  paramBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(params),
-                         const_cast<realtime_params*>(&params));
+  paramBuf_ = constantBuffer(rt, params);
   dev.bind(kernel_);
   kernel_.setArg(0, sceneBuf_);
   const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;

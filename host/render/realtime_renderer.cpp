@@ -88,8 +88,7 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* 
       buildProgram(rt, algorithm + ".cl", dev.scene.buildOptions, nullptr, &st.programFromCache);
   cl::Kernel kernel(program, algorithm.c_str());
   const size_t pixels = size_t(W) * size_t(H);
-  cl::Buffer paramBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof(params),
-                      const_cast<realtime_params*>(&params));
+  cl::Buffer paramBuf = constantBuffer(rt, params);
   cl::Buffer dirBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4), dirs.data());
   const AllocationSite site{scene.sourcePath, "renderer.resolution",
                             "an image of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};

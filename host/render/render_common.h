@@ -51,6 +51,12 @@ std::string rawBytes(const T& v) {
   return std::string(reinterpret_cast<const char*>(&v), sizeof v);
 }
 
+// A read-only device copy of a plain struct (a kernel's __constant parameters).
+template <typename T>
+cl::Buffer constantBuffer(ClRuntime& rt, const T& v) {
+  return cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof v, const_cast<T*>(&v));
+}
+
 // True once options.cancel is set (Ctrl-C): the render loops stop before their next pass.
 bool cancelled(const RenderOptions& options);
 

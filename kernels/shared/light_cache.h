@@ -13,7 +13,9 @@
  * the integral is evaluated, not how). One float serves every channel: σt(x) = σt_unit·ρ(x) with a
  * single σt_unit per medium (DESIGN.md physics), so τ = σt_unit·C; storing τ rather than e^{−τ}
  * also keeps the ray marcher's octaves exact (they need exp(−bⁱτ)) and interpolates the smooth
- * quantity: e^{−τ} of an interpolated τ never leaves [0, 1].
+ * quantity: e^{−τ} of an interpolated τ never leaves [0, 1]. For a rectangle with
+ * shadow_area_samples K > 1 the node holds the effective column over K×K points of the light
+ * (march_light_column), and the exact march without the cache computes the same.
  *
  * Lookup: trilinear over the 8 nodes around the point (node_grid.h, which states the bounds of
  * that interpolation). For a homogeneous medium of density 1, C is the length of the part of the

@@ -61,48 +61,40 @@
  * cell's eight nodes ("Interpolation"), at least 0. */
 static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache, vec3 dims,
                                    vec3 p, float g, vec3 w_out) {
-  const node_grid_cell cell = node_grid_locate(c, dims, p);
-  const size_t sy = (size_t)c->nx, sz = (size_t)c->nx * (size_t)c->ny;
   float w[8];
   size_t at[8];
-  for (int k = 0; k < 8; ++k) {
-    const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
-    at[k] = ((size_t)cell.base + (size_t)dx + (size_t)dy * sy + (size_t)dz * sz) * (size_t)MS_CACHE_STRIDE;
-    w[k] = (dx ? cell.ax : 1.0f - cell.ax) * (dy ? cell.ay : 1.0f - cell.ay) * (dz ? cell.az : 1.0f - cell.az);
-  }
+  node_grid_corners(c, node_grid_locate(c, dims, p), MS_CACHE_STRIDE, at, w);
   float out[3];
   for (int ch = 0; ch < 3; ++ch) {
-    /* R geometrically ("Interpolation"), the moment per unit R linearly; from the node's ln R and
-     * b/R when every corner has R > 0 (the build stores them: no log or division here). */
+    /* R geometrically ("Interpolation"), the moment per unit R linearly: from the node's ln R and
+     * b/R when every corner has R > 0 (the build stores them: no log or division here), else from
+     * the running means with R + floor. */
     int all_lit = 1;
     for (int k = 0; k < 8; ++k) all_lit &= cache[at[k] + MS_CACHE_LOG_R + (size_t)ch] > -NV_INFINITY;
-    if (all_lit) {
-      float log_r = 0.0f;
-      vec3 ratio = vec3_splat(0.0f);
-      for (int k = 0; k < 8; ++k) {
-        NV_GLOBAL const float* q = cache + at[k] + MS_CACHE_RATIO + 3 * ch;
-        log_r += w[k] * cache[at[k] + MS_CACHE_LOG_R + (size_t)ch];
-        ratio = vec3_add(ratio, vec3_scale(vec3_make(q[0], q[1], q[2]), w[k]));
-      }
-      const float R = nv_exp(log_r);
-      out[ch] = g != 0.0f ? nv_fmax(0.0f, R * (1.0f + g * vec3_dot(ratio, w_out))) : R;
-      continue;
-    }
-    /* A corner at 0: R + floor, from the running means. */
-    float top = 0.0f;
-    for (int k = 0; k < 8; ++k) top = nv_fmax(top, cache[at[k] + (size_t)ch]);
-    if (!(top > 0.0f)) {
-      out[ch] = 0.0f;
-      continue;
-    }
-    const float floor = MS_CACHE_LOG_FLOOR * top;
-    float log_r = 0.0f;
+    float log_r = 0.0f, floor = 0.0f;
     vec3 ratio = vec3_splat(0.0f);
-    for (int k = 0; k < 8; ++k) {
-      NV_GLOBAL const float* node = cache + at[k];
-      const float r = nv_fmax(node[ch], 0.0f) + floor;
-      log_r += w[k] * nv_log(r);
-      ratio = vec3_add(ratio, vec3_scale(vec3_make(node[4 + 4 * ch], node[5 + 4 * ch], node[6 + 4 * ch]), w[k] / r));
+    if (all_lit) {
+      for (int k = 0; k < 8; ++k) {
+        log_r += w[k] * cache[at[k] + MS_CACHE_LOG_R + (size_t)ch];
+        if (g != 0.0f) {
+          NV_GLOBAL const float* q = cache + at[k] + MS_CACHE_RATIO + 3 * ch;
+          ratio = vec3_add(ratio, vec3_scale(vec3_make(q[0], q[1], q[2]), w[k]));
+        }
+      }
+    } else {
+      float top = 0.0f;
+      for (int k = 0; k < 8; ++k) top = nv_fmax(top, cache[at[k] + (size_t)ch]);
+      if (!(top > 0.0f)) {
+        out[ch] = 0.0f;
+        continue;
+      }
+      floor = MS_CACHE_LOG_FLOOR * top;
+      for (int k = 0; k < 8; ++k) {
+        NV_GLOBAL const float* node = cache + at[k];
+        const float r = nv_fmax(node[ch], 0.0f) + floor;
+        log_r += w[k] * nv_log(r);
+        ratio = vec3_add(ratio, vec3_scale(vec3_make(node[4 + 4 * ch], node[5 + 4 * ch], node[6 + 4 * ch]), w[k] / r));
+      }
     }
     const float R = nv_fmax(nv_exp(log_r) - floor, 0.0f);
     out[ch] = g != 0.0f ? nv_fmax(0.0f, R * (1.0f + g * vec3_dot(ratio, w_out))) : R;

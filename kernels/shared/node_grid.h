@@ -48,6 +48,19 @@ static inline node_grid_cell node_grid_locate(NV_CONSTANT const node_grid_params
   return cell;
 }
 
+/* The cell's eight corners, k = dx + 2·dy + 4·dz: their offsets in a buffer of `stride` floats per
+ * node and their trilinear weights (summing to 1). For a lookup that combines the corners other
+ * than linearly (ms_cache.h). */
+static inline void node_grid_corners(NV_CONSTANT const node_grid_params* c, node_grid_cell cell, int stride,
+                                     NV_PRIVATE size_t* at, NV_PRIVATE float* w) {
+  const size_t sy = (size_t)c->nx, sz = (size_t)c->nx * (size_t)c->ny;
+  for (int k = 0; k < 8; ++k) {
+    const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
+    at[k] = ((size_t)cell.base + (size_t)dx + (size_t)dy * sy + (size_t)dz * sz) * (size_t)stride;
+    w[k] = (dx ? cell.ax : 1.0f - cell.ax) * (dy ? cell.ay : 1.0f - cell.ay) * (dz ? cell.az : 1.0f - cell.az);
+  }
+}
+
 /* Trilinear interpolation of the values v[stride·node] over the cell (grid_trilinear_combine, the
  * density lookups' arithmetic). */
 static inline float node_grid_interpolate(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* v, int stride,

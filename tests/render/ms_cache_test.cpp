@@ -246,8 +246,8 @@ ImageRGB averaged(const ImageRGB& a, const ImageRGB& b) {
 // the variances measured from two independent renders each (two seeds; tileVarianceOfMean). With
 // Gaussian tile means 4σ fails with probability 6e-5, 3e-3 for all 48 (the 16-dof variance
 // estimates widen this a little). It also asserts the bound is tight enough to mean something: below
-// 6% of the tile's value (measured 5.4%, at the corner tile nearest the light, where 8 and 16 cells
-// differ by 4%: interpolation, not noise, which is below 0.2% there), and that single scattering
+// 6% of the tile's value (measured 5.4%, at a corner tile, where 8 and 16 cells differ by 3.0%:
+// interpolation, not noise, which is 0.3% of the value there), and that single scattering
 // alone (no cache) is outside it nearly everywhere. Cells 8 → 16, steps 64 → 128; 2048 paths per
 // node, 2 × 16384 spp for the path tracer (about 6 s on 2 cores).
 TEST(MsCache, IsotropicLitBoxMatchesThePathTracer) {
