@@ -1,4 +1,7 @@
+#include <chrono>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -9,6 +12,7 @@
 #include "app/commands.h"
 #include "app/interrupt.h"
 #include "app/progress_bar.h"
+#include "display/display_server.h"
 #include "image/image.h"
 #include "render/pathtrace_renderer.h"
 #include "render/realtime_renderer.h"
@@ -26,7 +30,8 @@ struct RenderArgs {
   std::string scene, out, algorithm, resolution, device, statsJson, localSize = "8x8";
   int spp = -1, bounces = -1, frames = 0, samplesPerPass = 0, majorantResolution = 0;
   bool resume = false, counters = false;
-  std::string majorant = "auto", storage;
+  std::string majorant = "auto", storage, displayServer;
+  double partialEverySeconds = 0;
   long long seed = -1;
   std::vector<std::string> sets;
 };
@@ -147,6 +152,12 @@ int runRender(const RenderArgs& a) {
     }
   }
 
+  std::optional<HostPort> displayAt;
+  if (!a.displayServer.empty()) displayAt = parseHostPort(a.displayServer, "--display-server");
+  if (a.partialEverySeconds > 0 && realtime)
+    throw inputError("--write-partial-images", "", "only path-traced renders write partial images; the algorithm is " +
+                                                       scene.renderer.algorithm);
+
   // Everything the render needs is loaded and checked before the first sample.
   DenseGrid gridStorage;
   const DenseGrid* g = loadSceneGrid(scene, gridStorage);
@@ -169,9 +180,38 @@ int runRender(const RenderArgs& a) {
   options.majorant = majorant;
   options.majorantResolution = majorantResolution;
   options.counters = a.counters;
+  // Snapshots between passes: the display server's (its thread sends what changed, ~4 a second)
+  // and --write-partial-images' (the EXR so far, resumable, atomically over the output).
+  std::unique_ptr<DisplayServer> display;
+  if (displayAt)
+    display = std::make_unique<DisplayServer>(*displayAt, out.filename().string(), scene.renderer.width,
+                                              scene.renderer.height);
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point lastShown = Clock::now(), lastWritten = Clock::now();
+  const auto partialEvery = std::chrono::duration<double>(a.partialEverySeconds);
+  options.snapshotDue = [&]() {
+    const Clock::time_point now = Clock::now();
+    return (display && now - lastShown >= DisplayServer::kUpdateInterval) ||
+           (a.partialEverySeconds > 0 && now - lastWritten >= partialEvery);
+  };
+  options.snapshot = [&](const RenderResult& partial) {
+    const Clock::time_point now = Clock::now();
+    if (display && now - lastShown >= DisplayServer::kUpdateInterval) {
+      display->post(partial.image);
+      lastShown = now;
+    }
+    if (a.partialEverySeconds > 0 && now - lastWritten >= partialEvery) {
+      writeRenderExr(out.string(), partial, scene);
+      lastWritten = now;
+    }
+  };
   const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)
                                   : renderPathtrace(rt, scene, g, options);
   bar.finish();
+  if (display) {
+    if (r.image.width > 0) display->finish(r.image);
+    for (const std::string& w : display->warnings()) std::cerr << "narval: warning: " << w << "\n";
+  }
   for (const std::string& w : r.warnings) std::cerr << "narval: warning: " << w << "\n";
   const RenderStats& s = r.stats;
   if (r.image.width == 0) {
@@ -263,6 +303,13 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_flag("--counters", a->counters,
                 "pathtrace: count tentative and real collisions and density lookups (a kernel built to count; "
                 "--stats-json reports them)");
+  sub->add_option("--display-server", a->displayServer,
+                  "Stream the image being rendered to a running tev at HOST:PORT (tev listens on "
+                  "localhost:14158): the tiles that changed, about 4 times a second");
+  sub->add_option("--write-partial-images", a->partialEverySeconds,
+                  "pathtrace: every SECONDS, write the EXR so far over the output (atomically; --resume "
+                  "continues it)")
+      ->check(CLI::PositiveNumber);
   CLI::Option* frames = sub->get_option("--frames");
   sub->add_flag("--resume", a->resume,
                 "pathtrace: continue the render already at the output path (interrupted, or with fewer spp) "

@@ -92,6 +92,23 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   std::vector<double> kernelMs, wallMs;  // per pass: with one sample per pass, per frame
   const auto tLoop = std::chrono::steady_clock::now();
   int done = first;
+  // The accumulator after `done` samples into `into` (what the kernel has added: the image, the
+  // state --resume continues from, the status bits and the sample counts).
+  auto readBack = [&](RenderResult& into) {
+    AccumulatorState& acc = into.accumulator;
+    acc.samples = done;
+    acc.sum.resize(pixels * 4);
+    acc.comp.resize(pixels * 4);
+    rt.queue.enqueueReadBuffer(sumBuf, CL_TRUE, 0, accumBytes, acc.sum.data());
+    rt.queue.enqueueReadBuffer(compBuf, CL_TRUE, 0, accumBytes, acc.comp.data());
+    rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &into.stats.status);
+    acc.status = into.stats.status;
+    into.stats.spp = done;
+    into.stats.sppRequested = spp;
+    into.stats.resumedFromSpp = first;
+    into.stats.interrupted = done < spp;
+    if (done > 0) into.image = imageFromRgba(acc.sum, W, H, float(done), &into.stats.nanPixels);
+  };
   // Samples [done, done + count) per pass; the kernel adds them in index order, so any split of
   // the same samples (passes, interruption and --resume) gives the same bits.
   while (done < spp && !cancelled(options)) {
@@ -106,15 +123,14 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
     done += count;
     ++st.passes;
     if (options.progress) options.progress(done, spp);
+    if (done < spp && options.snapshot && options.snapshotDue && options.snapshotDue()) {
+      RenderResult partial;
+      partial.stats = st;
+      readBack(partial);
+      options.snapshot(partial);
+    }
   }
-  AccumulatorState& acc = result.accumulator;
-  acc.samples = done;
-  acc.sum.resize(pixels * 4);
-  acc.comp.resize(pixels * 4);
-  rt.queue.enqueueReadBuffer(sumBuf, CL_TRUE, 0, accumBytes, acc.sum.data());
-  rt.queue.enqueueReadBuffer(compBuf, CL_TRUE, 0, accumBytes, acc.comp.data());
-  rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &st.status);
-  acc.status = st.status;
+  readBack(result);
   if (options.counters) {
     std::vector<cl_ulong> counts(pixels * 3);
     rt.queue.enqueueReadBuffer(counterBuf, CL_TRUE, 0, counterBytes, counts.data());
@@ -126,13 +142,7 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid*
   }
   st.seconds = secondsSince(tLoop);
   st.frames = frameTimings(kernelMs, wallMs);
-  st.spp = done;
-  st.sppRequested = spp;
-  st.resumedFromSpp = first;
-  st.interrupted = done < spp;
   st.samplesPerSecond = st.seconds > 0 ? double(pixels) * (done - first) / st.seconds : 0.0;
-
-  if (done > 0) result.image = imageFromRgba(acc.sum, W, H, float(done), &st.nanPixels);
   return result;
 }
 

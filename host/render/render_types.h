@@ -38,6 +38,12 @@ struct RenderOptions {
   // (path tracer: pathtraceMajorantResolution; real-time kernels: kDefaultMajorantResolution). Also
   // the real-time kernels' empty-space skipping granularity.
   int majorantResolution = 0;
+  // pathtrace: asked after every pass but the last whether to read the samples so far back; when
+  // it says yes, `snapshot` gets them as a partial result (image, accumulator, the stats so far,
+  // `interrupted` set), e.g. for a display server or --write-partial-images. Reading back between
+  // passes changes no pixel.
+  std::function<bool()> snapshotDue;
+  std::function<void(const struct RenderResult&)> snapshot;
   // pathtrace: build with -DCOUNTERS and report collision and lookup counts in RenderStats.
   bool counters = false;
 };
