@@ -18,29 +18,13 @@
 #include <thread>
 
 #include "cli_fixture.h"
+#include "fog_scene.h"
 #include "image/image.h"
 
 namespace narval::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A scattering slab lit from behind, 100x70 (tiles of 64: four, two of them partial).
-const char* const kScene = R"({
-  "materials": [
-    {"name": "light", "type": "emitter", "albedo": [3, 3, 3]},
-    {"name": "fog", "type": "volume", "scattering": [0.9, 0.8, 0.7], "absorption": [0.1, 0.1, 0.1],
-     "phaseFunction": "hg", "g": 0.5, "density": 2}
-  ],
-  "primitives": [
-    {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 3], "scale": [4, 4, 1]},
-     "materialName": "light"},
-    {"name": "box", "type": "volume", "transform": {"position": [0, 0, 0], "scale": [2, 2, 2]},
-     "materialName": "fog"}
-  ],
-  "camera": {"position": [0, 0, -6], "lookAt": [0, 0, 0], "vfov": 30},
-  "renderer": {"resolution": [100, 70], "spp": 300, "bounces": 6, "seed": 7}
-})";
 
 // One decoded packet.
 struct Packet {
@@ -173,7 +157,8 @@ class Receiver {
 
 class DisplayServerCli : public CliFixture {
  protected:
-  void SetUp() override { write("fog.json", kScene); }
+  // 100x70: four tiles of 64, three of them partial.
+  void SetUp() override { write("fog.json", fogSceneJson(100, 70, 300)); }
   std::string file(const std::string& name) const { return (dir_ / name).string(); }
 };
 

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.h"
+#include "fog_scene.h"
 #include "image/image.h"
 
 namespace narval::test {
@@ -25,27 +26,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A scattering slab lit from behind: multiple bounces, so samples differ and the compensation
-// term of the accumulator is non-zero.
-const char* const kScene = R"({
-  "materials": [
-    {"name": "light", "type": "emitter", "albedo": [3, 3, 3]},
-    {"name": "fog", "type": "volume", "scattering": [0.9, 0.8, 0.7], "absorption": [0.1, 0.1, 0.1],
-     "phaseFunction": "hg", "g": 0.5, "density": 2}
-  ],
-  "primitives": [
-    {"name": "rect", "type": "rectangle", "transform": {"position": [0, 0, 3], "scale": [4, 4, 1]},
-     "materialName": "light"},
-    {"name": "box", "type": "volume", "transform": {"position": [0, 0, 0], "scale": [2, 2, 2]},
-     "materialName": "fog"}
-  ],
-  "camera": {"position": [0, 0, -6], "lookAt": [0, 0, 0], "vfov": 30},
-  "renderer": {"resolution": [24, 16], "spp": 1000000, "bounces": 6, "seed": 7, "exposure": 1}
-})";
-
 class InterruptCli : public CliFixture {
  protected:
-  void SetUp() override { write("fog.json", kScene); }
+  void SetUp() override { write("fog.json", fogSceneJson(24, 16, 1000000)); }
 
   // Starts `narval ARGS...` in the test folder, sends SIGINT after `delay`, and waits for it.
   RunResult runInterrupted(const std::vector<std::string>& args, std::chrono::milliseconds delay) {
