@@ -186,23 +186,24 @@ int runRender(const RenderArgs& a) {
   if (displayAt)
     display = std::make_unique<DisplayServer>(*displayAt, out.filename().string(), scene.renderer.width,
                                               scene.renderer.height);
-  using Clock = std::chrono::steady_clock;
-  Clock::time_point lastShown = Clock::now(), lastWritten = Clock::now();
-  const auto partialEvery = std::chrono::duration<double>(a.partialEverySeconds);
-  options.snapshotDue = [&]() {
-    const Clock::time_point now = Clock::now();
-    return (display && now - lastShown >= DisplayServer::kUpdateInterval) ||
-           (a.partialEverySeconds > 0 && now - lastWritten >= partialEvery);
+  // One timer per consumer: due once `every` has passed since it last took a snapshot.
+  struct Periodic {
+    bool on;
+    std::chrono::duration<double> every;
+    std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+    bool due() const { return on && std::chrono::steady_clock::now() - last >= every; }
   };
+  Periodic show{display && display->receiving(), DisplayServer::kUpdateInterval};
+  Periodic save{a.partialEverySeconds > 0, std::chrono::duration<double>(a.partialEverySeconds)};
+  options.snapshotDue = [&]() { return show.due() || save.due(); };
   options.snapshot = [&](const RenderResult& partial) {
-    const Clock::time_point now = Clock::now();
-    if (display && now - lastShown >= DisplayServer::kUpdateInterval) {
+    if (show.due()) {
       display->post(partial.image);
-      lastShown = now;
+      show.last = std::chrono::steady_clock::now();
     }
-    if (a.partialEverySeconds > 0 && now - lastWritten >= partialEvery) {
+    if (save.due()) {
       writeRenderExr(out.string(), partial, scene);
-      lastWritten = now;
+      save.last = std::chrono::steady_clock::now();
     }
   };
   const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)

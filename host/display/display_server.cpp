@@ -125,6 +125,11 @@ void DisplayServer::finish(const ImageRGB& image) {
   }
 }
 
+bool DisplayServer::receiving() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return alive_;
+}
+
 std::vector<std::string> DisplayServer::warnings() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return warnings_;

@@ -39,6 +39,8 @@ class DisplayServer {
   void post(const ImageRGB& image);
   // Sends `image` (the final state) now, stops the thread and closes the connection.
   void finish(const ImageRGB& image);
+  // Connected and not lost: whether a post() can reach the viewer (else snapshots are wasted).
+  bool receiving() const;
   // What went wrong (connection refused, viewer gone), one line each, for the command to print.
   std::vector<std::string> warnings() const;
 
