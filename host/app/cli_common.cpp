@@ -27,10 +27,4 @@ const DenseGrid* loadSceneGrid(const Scene& scene, DenseGrid& storage) {
   return nullptr;
 }
 
-void writeTextAtomic(const std::string& path, const std::string& text) {
-  AtomicFile f(path);
-  if (std::fwrite(text.data(), 1, text.size(), f.file()) != text.size()) f.fail("short write");
-  f.commit();
-}
-
 }  // namespace narval

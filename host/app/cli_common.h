@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "image/atomic_file.h"  // writeTextAtomic
 #include "scene/scene.h"
 #include "volume/grid.h"
 
@@ -16,8 +17,5 @@ std::pair<int, int> parseSize(const std::string& text, const std::string& what);
 // Loads the grid of the scene's volume primitive into `storage` and returns it, or null when the
 // scene has no volume or a homogeneous one. Throws InputError from the grid loader.
 const DenseGrid* loadSceneGrid(const Scene& scene, DenseGrid& storage);
-
-// Writes `text` to `path` through a temporary file and a rename (never a half-written file).
-void writeTextAtomic(const std::string& path, const std::string& text);
 
 }  // namespace narval

@@ -88,4 +88,10 @@ void AtomicFile::commit() {
   temp_.clear();
 }
 
+void writeTextAtomic(const std::string& path, const std::string& text) {
+  AtomicFile f(path);
+  if (std::fwrite(text.data(), 1, text.size(), f.file()) != text.size()) f.fail("short write");
+  f.commit();
+}
+
 }  // namespace narval

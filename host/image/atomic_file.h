@@ -38,4 +38,7 @@ class AtomicFile {
 // "PATH: cannot write: REASON", newlines in REASON folded so the message stays one line.
 std::string writeErrorMessage(const std::string& path, const std::string& reason);
 
+// Writes `text` to `path` through an AtomicFile (never a half-written file).
+void writeTextAtomic(const std::string& path, const std::string& text);
+
 }  // namespace narval

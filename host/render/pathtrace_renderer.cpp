@@ -25,124 +25,167 @@ int pathtraceSamplesPerPass(int width, int height, int spp) {
   return int(std::min<long long>(perPass, std::max(1, spp)));
 }
 
+PathtraceRenderer::PathtraceRenderer(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
+                                     const RenderOptions& options)
+    : rt_(rt), view_(scene), options_(options), dev_(rt, scene, grid) {
+  checkMajorantOptions(options);
+  const int W = scene.renderer.width, H = scene.renderer.height;
+  const AccumulatorState* resume = options.resumeFrom;
+  const size_t pixels = size_t(W) * size_t(H);
+  if (resume && (resume->sum.size() != pixels * 4 || resume->comp.size() != pixels * 4 ||
+                 resume->samples > scene.renderer.spp))
+    throw std::invalid_argument("renderPathtrace: the state to resume from does not fit this render");
+  warnings_ = dev_.scene.warnings;
+  stats_ = initialStats("pathtrace", rt, scene);
+  recordGridStorage(stats_, dev_);
+  stats_.majorant = resolveMajorant(options.majorant, rt.selected.info);
+  stats_.counters = options.counters;
+  applyMajorantResolution(rt, dev_,
+                          options.majorantResolution > 0 ? options.majorantResolution
+                                                         : pathtraceMajorantResolution(rt.selected.info),
+                          stats_);
+  program_ = buildProgram(
+      rt, "pathtrace.cl",
+      joinBuildOptions(dev_.scene.buildOptions, pathtraceMajorantBuildOptions(stats_.majorant, options.counters)),
+      nullptr, &stats_.programFromCache);
+  kernel_ = cl::Kernel(program_, "pathtrace");
+  statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
+  dev_.bind(kernel_);
+  allocateAccumulator();
+  if (resume) {
+    const size_t accumBytes = pixels * 4 * sizeof(float);
+    rt.queue.enqueueWriteBuffer(sumBuf_, CL_FALSE, 0, accumBytes, resume->sum.data());
+    rt.queue.enqueueWriteBuffer(compBuf_, CL_FALSE, 0, accumBytes, resume->comp.data());
+    rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(resume->status), 0, sizeof(cl_uint));
+    first_ = done_ = resume->samples;
+  }
+  rt.queue.finish();
+}
+
+void PathtraceRenderer::allocateAccumulator() {
+  const int W = view_.renderer.width, H = view_.renderer.height;
+  const size_t pixels = size_t(W) * size_t(H), accumBytes = pixels * 4 * sizeof(float);
+  const AllocationSite site{view_.sourcePath, "renderer.resolution",
+                            "an accumulator of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
+  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
+  if (sumBuf_() == nullptr || sumBuf_.getInfo<CL_MEM_SIZE>() != accumBytes) {
+    sumBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, accumBytes, site);
+    compBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, accumBytes, site);
+    kernel_.setArg(arg + 0, sumBuf_);
+    kernel_.setArg(arg + 1, compBuf_);
+    kernel_.setArg(arg + 4, statusBuf_);
+    // -DCOUNTERS: three ulongs per pixel, each work-item adding to its own (pathtrace.cl).
+    if (options_.counters) {
+      counterBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, pixels * 3 * sizeof(cl_ulong),
+                                   {view_.sourcePath, "renderer.resolution",
+                                    "collision counters of " + std::to_string(W) + "x" + std::to_string(H) +
+                                        " pixels"});
+      kernel_.setArg(arg + 5, counterBuf_);
+    }
+  }
+  reset();
+}
+
+void PathtraceRenderer::reset() {
+  const size_t pixels = size_t(view_.renderer.width) * size_t(view_.renderer.height);
+  rt_.queue.enqueueFillBuffer(sumBuf_, 0.0f, 0, pixels * 4 * sizeof(float));
+  rt_.queue.enqueueFillBuffer(compBuf_, 0.0f, 0, pixels * 4 * sizeof(float));
+  rt_.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
+  if (options_.counters) rt_.queue.enqueueFillBuffer(counterBuf_, cl_ulong(0), 0, pixels * 3 * sizeof(cl_ulong));
+  first_ = done_ = 0;
+}
+
+void PathtraceRenderer::setView(const Scene& view) {
+  const bool resized = view.renderer.width != view_.renderer.width || view.renderer.height != view_.renderer.height;
+  dev_.scene.params.camera = buildCamera(view);
+  rt_.queue.enqueueWriteBuffer(dev_.sceneBuf, CL_TRUE, 0, sizeof(scene_params), &dev_.scene.params);
+  view_ = view;
+  stats_.width = view.renderer.width;
+  stats_.height = view.renderer.height;
+  if (resized)
+    allocateAccumulator();
+  else
+    reset();
+}
+
+double PathtraceRenderer::addSamples(int count) {
+  const int W = view_.renderer.width, H = view_.renderer.height;
+  const size_t pixels = size_t(W) * size_t(H);
+  const size_t deviceBytes = deviceSceneBytes(dev_.scene) + 2 * pixels * 4 * sizeof(float) +
+                             (options_.counters ? pixels * 3 * sizeof(cl_ulong) : 0);
+  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
+  kernel_.setArg(arg + 2, cl_uint(done_));
+  kernel_.setArg(arg + 3, cl_uint(count));
+  const cl::Event ev = launchAndWait(rt_, kernel_, paddedGlobalRange(W, H, options_), localRange(options_),
+                                     "pathtrace", deviceBytes);
+  done_ += count;
+  ++stats_.passes;
+  const double ms = eventSeconds(ev) * 1e3;
+  stats_.kernelSeconds += ms * 1e-3;
+  return ms;
+}
+
+void PathtraceRenderer::readBack(RenderResult& into) {
+  const int W = view_.renderer.width, H = view_.renderer.height;
+  const size_t pixels = size_t(W) * size_t(H), accumBytes = pixels * 4 * sizeof(float);
+  AccumulatorState& acc = into.accumulator;
+  acc.samples = done_;
+  acc.sum.resize(pixels * 4);
+  acc.comp.resize(pixels * 4);
+  rt_.queue.enqueueReadBuffer(sumBuf_, CL_TRUE, 0, accumBytes, acc.sum.data());
+  rt_.queue.enqueueReadBuffer(compBuf_, CL_TRUE, 0, accumBytes, acc.comp.data());
+  rt_.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof(cl_uint), &into.stats.status);
+  acc.status = into.stats.status;
+  into.stats.spp = done_;
+  into.stats.sppRequested = view_.renderer.spp;
+  into.stats.resumedFromSpp = first_;
+  into.stats.interrupted = done_ < view_.renderer.spp;
+  if (done_ > 0) into.image = imageFromRgba(acc.sum, W, H, float(done_), &into.stats.nanPixels);
+  if (options_.counters) {
+    std::vector<cl_ulong> counts(pixels * 3);
+    rt_.queue.enqueueReadBuffer(counterBuf_, CL_TRUE, 0, counts.size() * sizeof(cl_ulong), counts.data());
+    into.stats.collisionsTentative = into.stats.collisionsReal = into.stats.densityLookups = 0;
+    for (size_t i = 0; i < pixels; ++i) {
+      into.stats.collisionsTentative += counts[3 * i + 0];
+      into.stats.collisionsReal += counts[3 * i + 1];
+      into.stats.densityLookups += counts[3 * i + 2];
+    }
+  }
+}
+
 RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
                              const RenderOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
+  PathtraceRenderer renderer(rt, scene, grid, options);
+  renderer.stats().buildSeconds = secondsSince(t0);
   const int W = scene.renderer.width, H = scene.renderer.height, spp = scene.renderer.spp;
-  checkMajorantOptions(options);
-  DeviceSceneBuffers dev(rt, scene, grid);
-  const size_t pixels = size_t(W) * size_t(H), accumBytes = pixels * 4 * sizeof(float);
-  const AccumulatorState* resume = options.resumeFrom;
-  if (resume && (resume->sum.size() != pixels * 4 || resume->comp.size() != pixels * 4 || resume->samples > spp))
-    throw std::invalid_argument("renderPathtrace: the state to resume from does not fit this render");
-
   RenderResult result;
-  result.warnings = dev.scene.warnings;
-  result.stats = initialStats("pathtrace", rt, scene);
-  RenderStats& st = result.stats;
-  recordGridStorage(st, dev);
-  st.majorant = resolveMajorant(options.majorant, rt.selected.info);
-  st.counters = options.counters;
-  applyMajorantResolution(rt, dev,
-                          options.majorantResolution > 0 ? options.majorantResolution
-                                                         : pathtraceMajorantResolution(rt.selected.info),
-                          st);
-
-  cl::Program program = buildProgram(
-      rt, "pathtrace.cl",
-      joinBuildOptions(dev.scene.buildOptions, pathtraceMajorantBuildOptions(st.majorant, options.counters)), nullptr,
-      &st.programFromCache);
-  cl::Kernel kernel(program, "pathtrace");
-
-  const AllocationSite site{scene.sourcePath, "renderer.resolution",
-                            "an accumulator of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
-  cl::Buffer sumBuf = allocateBuffer(rt, CL_MEM_READ_WRITE, accumBytes, site);
-  cl::Buffer compBuf = allocateBuffer(rt, CL_MEM_READ_WRITE, accumBytes, site);
-  cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
-  if (resume) {
-    rt.queue.enqueueWriteBuffer(sumBuf, CL_FALSE, 0, accumBytes, resume->sum.data());
-    rt.queue.enqueueWriteBuffer(compBuf, CL_FALSE, 0, accumBytes, resume->comp.data());
-  } else {
-    rt.queue.enqueueFillBuffer(sumBuf, 0.0f, 0, accumBytes);
-    rt.queue.enqueueFillBuffer(compBuf, 0.0f, 0, accumBytes);
-  }
-  rt.queue.enqueueFillBuffer(statusBuf, cl_uint(resume ? resume->status : 0u), 0, sizeof(cl_uint));
-  dev.bind(kernel);
-  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
-  kernel.setArg(arg + 0, sumBuf);
-  kernel.setArg(arg + 1, compBuf);
-  kernel.setArg(arg + 4, statusBuf);
-  // -DCOUNTERS: three ulongs per pixel, each work-item adding to its own (pathtrace.cl).
-  const size_t counterBytes = options.counters ? pixels * 3 * sizeof(cl_ulong) : 0;
-  cl::Buffer counterBuf;
-  if (options.counters) {
-    counterBuf = allocateBuffer(rt, CL_MEM_READ_WRITE, counterBytes,
-                                {scene.sourcePath, "renderer.resolution",
-                                 "collision counters of " + std::to_string(W) + "x" + std::to_string(H) + " pixels"});
-    rt.queue.enqueueFillBuffer(counterBuf, cl_ulong(0), 0, counterBytes);
-    kernel.setArg(arg + 5, counterBuf);
-  }
-  rt.queue.finish();
-  st.buildSeconds = secondsSince(t0);
-
-  const cl::NDRange global = paddedGlobalRange(W, H, options), local = localRange(options);
-  const size_t deviceBytes = deviceSceneBytes(dev.scene) + 2 * accumBytes + counterBytes;
+  result.warnings = renderer.warnings();
   const int perPass = options.samplesPerPass > 0 ? options.samplesPerPass : pathtraceSamplesPerPass(W, H, spp);
-  const int first = resume ? resume->samples : 0;
+  const int first = renderer.samples();
   std::vector<double> kernelMs, wallMs;  // per pass: with one sample per pass, per frame
   const auto tLoop = std::chrono::steady_clock::now();
-  int done = first;
-  // The accumulator after `done` samples into `into` (what the kernel has added: the image, the
-  // state --resume continues from, the status bits and the sample counts).
-  auto readBack = [&](RenderResult& into) {
-    AccumulatorState& acc = into.accumulator;
-    acc.samples = done;
-    acc.sum.resize(pixels * 4);
-    acc.comp.resize(pixels * 4);
-    rt.queue.enqueueReadBuffer(sumBuf, CL_TRUE, 0, accumBytes, acc.sum.data());
-    rt.queue.enqueueReadBuffer(compBuf, CL_TRUE, 0, accumBytes, acc.comp.data());
-    rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &into.stats.status);
-    acc.status = into.stats.status;
-    into.stats.spp = done;
-    into.stats.sppRequested = spp;
-    into.stats.resumedFromSpp = first;
-    into.stats.interrupted = done < spp;
-    if (done > 0) into.image = imageFromRgba(acc.sum, W, H, float(done), &into.stats.nanPixels);
-  };
   // Samples [done, done + count) per pass; the kernel adds them in index order, so any split of
   // the same samples (passes, interruption and --resume) gives the same bits.
-  while (done < spp && !cancelled(options)) {
-    const int count = std::min(perPass, spp - done);
-    kernel.setArg(arg + 2, cl_uint(done));
-    kernel.setArg(arg + 3, cl_uint(count));
+  while (renderer.samples() < spp && !cancelled(options)) {
+    const int count = std::min(perPass, spp - renderer.samples());
     const auto tPass = std::chrono::steady_clock::now();
-    const cl::Event ev = launchAndWait(rt, kernel, global, local, "pathtrace", deviceBytes);
+    kernelMs.push_back(renderer.addSamples(count));
     wallMs.push_back(secondsSince(tPass) * 1e3);
-    kernelMs.push_back(eventSeconds(ev) * 1e3);
-    st.kernelSeconds += kernelMs.back() * 1e-3;
-    done += count;
-    ++st.passes;
-    if (options.progress) options.progress(done, spp);
-    if (done < spp && options.snapshot && options.snapshotDue && options.snapshotDue()) {
+    if (options.progress) options.progress(renderer.samples(), spp);
+    if (renderer.samples() < spp && options.snapshot && options.snapshotDue && options.snapshotDue()) {
       RenderResult partial;
-      partial.stats = st;
-      readBack(partial);
+      partial.stats = renderer.stats();
+      renderer.readBack(partial);
       options.snapshot(partial);
     }
   }
-  readBack(result);
-  if (options.counters) {
-    std::vector<cl_ulong> counts(pixels * 3);
-    rt.queue.enqueueReadBuffer(counterBuf, CL_TRUE, 0, counterBytes, counts.data());
-    for (size_t i = 0; i < pixels; ++i) {
-      st.collisionsTentative += counts[3 * i + 0];
-      st.collisionsReal += counts[3 * i + 1];
-      st.densityLookups += counts[3 * i + 2];
-    }
-  }
+  result.stats = renderer.stats();
+  renderer.readBack(result);
+  RenderStats& st = result.stats;
   st.seconds = secondsSince(tLoop);
   st.frames = frameTimings(kernelMs, wallMs);
-  st.samplesPerSecond = st.seconds > 0 ? double(pixels) * (done - first) / st.seconds : 0.0;
+  st.samplesPerSecond = st.seconds > 0 ? double(W) * H * (renderer.samples() - first) / st.seconds : 0.0;
   return result;
 }
 

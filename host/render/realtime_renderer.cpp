@@ -51,109 +51,168 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   return p;
 }
 
-RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, int frames,
-                            const RenderOptions& options) {
+RealtimeRenderer::RealtimeRenderer(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
+                                   const RenderOptions& options)
+    : rt_(rt), view_(scene), options_(options), dev_(rt, checkedScene(scene, options), grid) {
   const std::string& algorithm = scene.renderer.algorithm;
-  if (algorithm != "raymarch" && algorithm != "lobe")
-    throw std::invalid_argument("renderRealtime: not a real-time algorithm: " + algorithm);
-  const auto t0 = std::chrono::steady_clock::now();
-  const int W = scene.renderer.width, H = scene.renderer.height;
-  checkMajorantOptions(options);
-  DeviceSceneBuffers dev(rt, scene, grid);
-
-  RenderResult result;
-  result.warnings = dev.scene.warnings;
-  result.stats = initialStats(algorithm, rt, scene);
-  RenderStats& st = result.stats;
-  recordGridStorage(st, dev);
-  st.majorant = "grid";  // the marches always skip empty cells (march.h); options.majorant is the path tracer's
+  warnings_ = dev_.scene.warnings;
+  stats_ = initialStats(algorithm, rt, scene);
+  recordGridStorage(stats_, dev_);
+  stats_.majorant = "grid";  // the marches always skip empty cells (march.h); options.majorant is the path tracer's
   // The marches place their samples over the occupied cells of the majorant grid (march.h), so its
   // resolution is part of their quadrature: they keep buildDeviceScene's, whatever the path
   // tracer's --majorant-resolution says, and that flag changes no real-time pixel.
-  applyMajorantResolution(rt, dev, 0, st);
+  applyMajorantResolution(rt, dev_, 0, stats_);
   if (options.majorantResolution > 0)
-    result.warnings.push_back("--majorant-resolution applies to the path tracer; " + algorithm +
-                              " samples over the occupied cells of the default " +
-                              std::to_string(kDefaultMajorantResolution) + "-cell grid");
-  st.spp = st.sppRequested = 1;
+    warnings_.push_back("--majorant-resolution applies to the path tracer; " + algorithm +
+                        " samples over the occupied cells of the default " +
+                        std::to_string(kDefaultMajorantResolution) + "-cell grid");
+  stats_.spp = stats_.sppRequested = 1;
+  program_ = buildProgram(rt, algorithm + ".cl", dev_.scene.buildOptions, nullptr, &stats_.programFromCache);
+  kernel_ = cl::Kernel(program_, algorithm.c_str());
+  statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
+  rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
+  noCache_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY, sizeof(float));  // for a cache that is off: never read
+  dev_.bind(kernel_);
+  kernel_.setArg(DeviceSceneBuffers::kFirstFreeArg + 5, statusBuf_);
+  view_.renderer.width = view_.renderer.height = 0;  // setView uploads everything the first time
+  setView(scene);
+}
 
-  const realtime_params params = realtimeParams(scene, dev.scene, rt.selected.info.maxAllocBytes);
-  DeviceLightCache lightCache;
-  DeviceMsCache msCache;
-  const scene_params& sp = dev.scene.params;
-  const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
-  std::vector<nv_float4> dirs = algorithm == "lobe" ? lobeDirections(params.lobe_points, g, scene.renderer.seed)
-                                                    : std::vector<nv_float4>(1, nv_float4{0, 0, 1, 0});
-  cl::Program program =
-      buildProgram(rt, algorithm + ".cl", dev.scene.buildOptions, nullptr, &st.programFromCache);
-  cl::Kernel kernel(program, algorithm.c_str());
-  const size_t pixels = size_t(W) * size_t(H);
-  cl::Buffer paramBuf = constantBuffer(rt, params);
-  cl::Buffer dirBuf(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4), dirs.data());
-  const AllocationSite site{scene.sourcePath, "renderer.resolution",
-                            "an image of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
-  cl::Buffer outBuf = allocateBuffer(rt, CL_MEM_WRITE_ONLY, pixels * 4 * sizeof(float), site);
-  cl::Buffer statusBuf(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
-  rt.queue.enqueueFillBuffer(statusBuf, cl_uint(0), 0, sizeof(cl_uint));
-  dev.bind(kernel);
+const Scene& RealtimeRenderer::checkedScene(const Scene& scene, const RenderOptions& options) {
+  const std::string& algorithm = scene.renderer.algorithm;
+  if (algorithm != "raymarch" && algorithm != "lobe")
+    throw std::invalid_argument("RealtimeRenderer: not a real-time algorithm: " + algorithm);
+  checkMajorantOptions(options);
+  return scene;
+}
+
+void RealtimeRenderer::setView(const Scene& view) {
+  if (view.renderer.algorithm != view_.renderer.algorithm)
+    throw std::invalid_argument("RealtimeRenderer::setView: another algorithm (" + view.renderer.algorithm + ")");
   const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
-  kernel.setArg(arg + 0, paramBuf);
-  kernel.setArg(arg + 1, dirBuf);
-  kernel.setArg(arg + 4, outBuf);
-  kernel.setArg(arg + 5, statusBuf);
-  const cl::Buffer noCache(rt.context, CL_MEM_READ_ONLY, sizeof(float));  // for a cache that is off: never read
-  if (params.light_cache.nx == 0) kernel.setArg(arg + 2, noCache);
-  if (params.ms_cache.nx == 0) kernel.setArg(arg + 3, noCache);
+  const int W = view.renderer.width, H = view.renderer.height;
+  const bool resized = W != view_.renderer.width || H != view_.renderer.height;
+  const camera_params camera = buildCamera(view);
+  if (rawBytes(camera) != rawBytes(dev_.scene.params.camera) || resized) {
+    dev_.scene.params.camera = camera;
+    rt_.queue.enqueueWriteBuffer(dev_.sceneBuf, CL_TRUE, 0, sizeof(scene_params), &dev_.scene.params);
+  }
+  const realtime_params params = realtimeParams(view, dev_.scene, rt_.selected.info.maxAllocBytes);
+  if (rawBytes(params) != rawBytes(params_) || !paramBuf_()) {
+    paramBuf_ = constantBuffer(rt_, params);
+    kernel_.setArg(arg + 0, paramBuf_);
+    if (params.light_cache.nx == 0) kernel_.setArg(arg + 2, noCache_);
+    if (params.ms_cache.nx == 0) kernel_.setArg(arg + 3, noCache_);
+  }
+  // The lobe's directions depend on its point count (and g, seed: the scene's); one dummy otherwise.
+  if (params.lobe_points != params_.lobe_points || !dirBuf_()) {
+    const scene_params& sp = dev_.scene.params;
+    const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
+    std::vector<nv_float4> dirs = view.renderer.algorithm == "lobe"
+                                      ? lobeDirections(params.lobe_points, g, view.renderer.seed)
+                                      : std::vector<nv_float4>(1, nv_float4{0, 0, 1, 0});
+    dirCount_ = dirs.size();
+    dirBuf_ = cl::Buffer(rt_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4),
+                         dirs.data());
+    kernel_.setArg(arg + 1, dirBuf_);
+  }
+  params_ = params;
+  if (resized) {
+    const AllocationSite site{view.sourcePath, "renderer.resolution",
+                              "an image of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
+    outBuf_ = allocateBuffer(rt_, CL_MEM_WRITE_ONLY, size_t(W) * size_t(H) * 4 * sizeof(float), site);
+    kernel_.setArg(arg + 4, outBuf_);
+  }
+  view_ = view;
+  stats_.width = W;
+  stats_.height = H;
+}
+
+double RealtimeRenderer::renderFrame(bool progressiveCache, double* wallMs) {
+  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
+  if (params_.light_cache.nx > 0) {  // a no-op unless the medium or a light changed
+    lightCache_.update(rt_, dev_, params_, view_.sourcePath);
+    kernel_.setArg(arg + 2, lightCache_.buffer());
+  }
+  if (params_.ms_cache.nx > 0) {  // built to its paths (progressively: one launch a frame), then kept
+    const MsCacheSettings& mc = view_.renderer.raymarch.msCache;
+    const int target = progressiveCache ? std::min(mc.paths, msCache_.paths() + mc.pathsPerLaunch) : mc.paths;
+    msCache_.refine(rt_, dev_, params_, target, mc.pathsPerLaunch, view_.sourcePath);
+    kernel_.setArg(arg + 3, msCache_.buffer());
+  }
+  const int W = view_.renderer.width, H = view_.renderer.height;
+  const size_t deviceBytes = deviceSceneBytes(dev_.scene) + size_t(W) * size_t(H) * 4 * sizeof(float) +
+                             sizeof(params_) + dirCount_ * sizeof(nv_float4) + lightCache_.bytes() + msCache_.bytes();
+  const auto t0 = std::chrono::steady_clock::now();
+  const cl::Event ev = launchAndWait(rt_, kernel_, paddedGlobalRange(W, H, options_), localRange(options_),
+                                     view_.renderer.algorithm, deviceBytes);
+  if (wallMs) *wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  ++stats_.passes;
+  return eventSeconds(ev) * 1e3;
+}
+
+bool RealtimeRenderer::cacheComplete() const {
+  return params_.ms_cache.nx == 0 || msCache_.paths() >= view_.renderer.raymarch.msCache.paths;
+}
+
+RenderResult RealtimeRenderer::result() {
+  RenderResult result;
+  result.warnings = warnings_;
+  result.stats = stats_;
+  RenderStats& st = result.stats;
+  const int W = view_.renderer.width, H = view_.renderer.height;
+  std::vector<float> rgba(size_t(W) * size_t(H) * 4);
+  rt_.queue.enqueueReadBuffer(outBuf_, CL_TRUE, 0, rgba.size() * sizeof(float), rgba.data());
+  rt_.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof(cl_uint), &st.status);
+  st.status |= lightCache_.status();
+  st.lightCacheMs = lightCache_.buildMs();
+  st.lightCacheBuilds = lightCache_.slabsBuilt();
+  st.lightCacheBytes = lightCache_.bytes();
+  nodeGridCells(params_.light_cache, st.lightCacheCells);
+  st.status |= msCache_.status();
+  st.msCacheMs = msCache_.buildMs();
+  st.msCachePaths = msCache_.paths();
+  st.msCacheBuilds = msCache_.rebuilds();
+  nodeGridCells(params_.ms_cache, st.msCacheCells);
+  result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
+  return result;
+}
+
+RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, int frames,
+                            const RenderOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RealtimeRenderer renderer(rt, scene, grid, options);
   rt.queue.finish();
-  st.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // One launch per frame, each timed by its profiling event and by the wall clock around it.
-  const cl::NDRange global = paddedGlobalRange(W, H, options), local = localRange(options);
-  const size_t deviceBytes = deviceSceneBytes(dev.scene) + pixels * 4 * sizeof(float) + sizeof(params) +
-                             dirs.size() * sizeof(nv_float4);
   const int requested = std::max(1, frames);
   std::vector<double> kernelMs, wallMs;
   for (int f = 0; f < requested && !cancelled(options); ++f) {
-    if (params.light_cache.nx > 0) {  // a no-op unless the scene changed (never, within one render)
-      lightCache.update(rt, dev, params, scene.sourcePath);
-      kernel.setArg(arg + 2, lightCache.buffer());
-    }
-    if (params.ms_cache.nx > 0) {  // likewise: built to its paths before the first frame, then kept
-      const MsCacheSettings& mc = scene.renderer.raymarch.msCache;
-      msCache.refine(rt, dev, params, mc.paths, mc.pathsPerLaunch, scene.sourcePath);
-      kernel.setArg(arg + 3, msCache.buffer());
-    }
-    const auto tf = std::chrono::steady_clock::now();
-    const cl::Event ev =
-        launchAndWait(rt, kernel, global, local, algorithm, deviceBytes + lightCache.bytes() + msCache.bytes());
-    wallMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tf).count());
-    kernelMs.push_back(eventSeconds(ev) * 1e3);
+    double wall = 0;
+    kernelMs.push_back(renderer.renderFrame(false, &wall));
+    wallMs.push_back(wall);
     if (options.progress) options.progress(f + 1, requested);
   }
-  st.interrupted = int(kernelMs.size()) < requested;
   if (kernelMs.empty()) {
-    st.spp = 0;
+    RenderResult result;
+    result.warnings = renderer.warnings();
+    result.stats = renderer.stats();
+    result.stats.buildSeconds = buildSeconds;
+    result.stats.interrupted = true;
+    result.stats.spp = 0;
     return result;
   }
-  std::vector<float> rgba(pixels * 4);
-  rt.queue.enqueueReadBuffer(outBuf, CL_TRUE, 0, rgba.size() * sizeof(float), rgba.data());
-  rt.queue.enqueueReadBuffer(statusBuf, CL_TRUE, 0, sizeof(cl_uint), &st.status);
-  st.passes = int(kernelMs.size());
-  st.status |= lightCache.status();
-  st.lightCacheMs = lightCache.buildMs();
-  st.lightCacheBuilds = lightCache.slabsBuilt();
-  st.lightCacheBytes = lightCache.bytes();
-  nodeGridCells(params.light_cache, st.lightCacheCells);
-  st.status |= msCache.status();
-  st.msCacheMs = msCache.buildMs();
-  st.msCachePaths = msCache.paths();
-  st.msCacheBuilds = msCache.rebuilds();
-  nodeGridCells(params.ms_cache, st.msCacheCells);
+  RenderResult result = renderer.result();
+  RenderStats& st = result.stats;
+  st.buildSeconds = buildSeconds;
+  st.interrupted = int(kernelMs.size()) < requested;
   st.frames = frameTimings(kernelMs, wallMs);
   for (double ms : kernelMs) st.kernelSeconds += ms * 1e-3;
   for (double ms : wallMs) st.seconds += ms * 1e-3;
+  const size_t pixels = size_t(scene.renderer.width) * size_t(scene.renderer.height);
   st.samplesPerSecond = st.seconds > 0 ? double(pixels) * st.passes / st.seconds : 0.0;
-  result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
   return result;
 }
 

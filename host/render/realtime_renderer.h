@@ -6,8 +6,13 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "cl/cl_runtime.h"
+#include "render/device_scene.h"
+#include "render/light_cache.h"
+#include "render/ms_cache.h"
 #include "render/render_types.h"
 #include "render/scene_upload.h"
 #include "scene/scene.h"
@@ -20,6 +25,49 @@ namespace narval {
 // settings; the light cache's layout (lightCacheLayout) needs the scene as uploaded.
 // maxAllocBytes: the device's largest allocation, which an automatic cache resolution must fit.
 realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes = SIZE_MAX);
+
+// A real-time renderer held across frames: the program, the scene on the device and the caches are
+// built once; the camera, the resolution and the quality settings may change between frames
+// (setView) without rebuilding them. `narval render` runs one for its frames (renderRealtime), the
+// viewer one per real-time algorithm, so both draw with the same code.
+class RealtimeRenderer {
+ public:
+  // scene.renderer.algorithm must be "raymarch" or "lobe". Builds the program and uploads the scene;
+  // the caches are built by the first frame.
+  RealtimeRenderer(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, const RenderOptions& options = {});
+  // The next frames show `view`: the constructor's scene with another camera, renderer.resolution or
+  // renderer.raymarch / renderer.lobe settings (its medium, lights and algorithm unchanged).
+  void setView(const Scene& view);
+  // One frame: brings the caches up to date (progressiveCache: at most one launch of the
+  // multiple-scattering cache, so a viewer refines it over frames; otherwise all of it), then one
+  // launch of the kernel, waited for. Returns its milliseconds by profiling event; wallMs, when not
+  // null, gets the wall clock around the launch.
+  double renderFrame(bool progressiveCache = false, double* wallMs = nullptr);
+  // The last frame read back (image, status, caches' statistics); stats.frames stays empty.
+  RenderResult result();
+  // Whether the multiple-scattering cache holds all the paths the scene asks for (true without it).
+  bool cacheComplete() const;
+  const RenderStats& stats() const { return stats_; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  const DeviceScene& deviceScene() const { return dev_.scene; }
+
+ private:
+  // The scene, once its algorithm and the options are known to suit a real-time renderer.
+  static const Scene& checkedScene(const Scene& scene, const RenderOptions& options);
+  ClRuntime& rt_;
+  Scene view_;
+  RenderOptions options_;
+  DeviceSceneBuffers dev_;
+  realtime_params params_{};
+  DeviceLightCache lightCache_;
+  DeviceMsCache msCache_;
+  cl::Program program_;
+  cl::Kernel kernel_;
+  cl::Buffer paramBuf_, dirBuf_, outBuf_, statusBuf_, noCache_;
+  size_t dirCount_ = 0;
+  RenderStats stats_;
+  std::vector<std::string> warnings_;
+};
 
 // Renders scene.renderer.algorithm ("raymarch" or "lobe") `frames` times (>= 1); the image is the
 // last frame (every frame is the same: the kernels are deterministic).

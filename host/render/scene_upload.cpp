@@ -47,26 +47,6 @@ nv_affine rotationOnly(const Transform& t) {
   return transformMatrix(r);
 }
 
-camera_params buildCamera(const Scene& scene) {
-  const Camera& c = scene.camera;
-  camera_params cam{};
-  const V3 pos = v3(c.position);
-  const V3 fwd = normalize(sub(v3(c.lookAt), pos));
-  const V3 right = normalize(cross(fwd, v3(c.up)));
-  const V3 up = cross(right, fwd);
-  cam.position = f4(pos.x, pos.y, pos.z);
-  cam.forward = f4(fwd.x, fwd.y, fwd.z);
-  cam.right = f4(right.x, right.y, right.z);
-  cam.up = f4(up.x, up.y, up.z);
-  cam.width = scene.renderer.width;
-  cam.height = scene.renderer.height;
-  cam.aspect = float(cam.width) / float(cam.height);
-  cam.tan_half_vfov = std::tan(0.5f * c.vfov * kDegToRad);
-  cam.lens_radius = c.aperture;
-  cam.focus_distance = c.focus;
-  return cam;
-}
-
 light_params buildLight(const Primitive& p, const Material& m) {
   light_params l{};
   l.radiance = f4(m.albedo);
@@ -91,6 +71,26 @@ light_params buildLight(const Primitive& p, const Material& m) {
 }
 
 }  // namespace
+
+camera_params buildCamera(const Scene& scene) {
+  const Camera& c = scene.camera;
+  camera_params cam{};
+  const V3 pos = v3(c.position);
+  const V3 fwd = normalize(sub(v3(c.lookAt), pos));
+  const V3 right = normalize(cross(fwd, v3(c.up)));
+  const V3 up = cross(right, fwd);
+  cam.position = f4(pos.x, pos.y, pos.z);
+  cam.forward = f4(fwd.x, fwd.y, fwd.z);
+  cam.right = f4(right.x, right.y, right.z);
+  cam.up = f4(up.x, up.y, up.z);
+  cam.width = scene.renderer.width;
+  cam.height = scene.renderer.height;
+  cam.aspect = float(cam.width) / float(cam.height);
+  cam.tan_half_vfov = std::tan(0.5f * c.vfov * kDegToRad);
+  cam.lens_radius = c.aperture;
+  cam.focus_distance = c.focus;
+  return cam;
+}
 
 nv_affine transformMatrix(const Transform& t) {
   const float ax = t.rotation[0] * kDegToRad, ay = t.rotation[1] * kDegToRad, az = t.rotation[2] * kDegToRad;
@@ -151,6 +151,27 @@ nv_affine affineInverse(const nv_affine& a) {
     out[i][3] = float(s);
   }
   return fromRows(out);
+}
+
+bool mediumWorldBounds(const DeviceScene& ds, float lo[3], float hi[3]) {
+  const scene_params& sp = ds.params;
+  if (!sp.has_medium) return false;
+  const nv_affine toWorld = affineInverse(sp.medium.world_to_index);
+  const float dims[3] = {sp.medium.dims.x, sp.medium.dims.y, sp.medium.dims.z};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = INFINITY;
+    hi[a] = -INFINITY;
+  }
+  for (int corner = 0; corner < 8; ++corner) {
+    const float p[3] = {corner & 1 ? dims[0] : 0.0f, corner & 2 ? dims[1] : 0.0f, corner & 4 ? dims[2] : 0.0f};
+    for (int a = 0; a < 3; ++a) {
+      const nv_float4& row = toWorld.row[a];
+      const float w = row.x * p[0] + row.y * p[1] + row.z * p[2] + row.w;
+      lo[a] = std::fmin(lo[a], w);
+      hi[a] = std::fmax(hi[a], w);
+    }
+  }
+  return true;
 }
 
 DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {

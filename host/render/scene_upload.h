@@ -32,6 +32,13 @@ nv_affine affineMultiply(const nv_affine& a, const nv_affine& b);
 // Throws std::domain_error for a singular map.
 nv_affine affineInverse(const nv_affine& m);
 
+// The camera of `scene` at its renderer.resolution (a viewer changes both between frames).
+camera_params buildCamera(const Scene& scene);
+
+// The world-space bounding box of the medium's box (its index box [0, dims] through the inverse of
+// medium.world_to_index), e.g. for a viewer to frame it. False (lo, hi untouched) without a medium.
+bool mediumWorldBounds(const DeviceScene& ds, float lo[3], float hi[3]);
+
 // `grid` must be the volume's loaded grid (or null for a homogeneous medium / no volume).
 // Throws InputError for geometry the renderer cannot use (a singular volume transform).
 DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid);
