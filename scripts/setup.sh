@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs missing Debian packages (as root or with passwordless sudo; otherwise prints the apt-get
-# line and stops), then
-# configures and builds Release into build/ (binary build/narval) and generates the default cloud.
+# line and stops): the toolchain, PoCL, the libraries, and for the viewer GLFW, GLM and OpenGL, with
+# Xvfb and Mesa for its headless tests. Then configures and builds Release into build/ (binary
+# build/narval) and generates the default cloud.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -9,7 +10,8 @@ packages=(build-essential cmake pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libopenexr-dev libpng-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-  clang libclang-rt-dev)
+  clang libclang-rt-dev
+  libglfw3-dev libglm-dev libgl1-mesa-dri libglx-mesa0 xvfb xauth)
 
 missing=()
 for p in "${packages[@]}"; do

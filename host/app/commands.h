@@ -18,5 +18,6 @@ Command addDevicesCommand(CLI::App& app);
 Command addMakeCloudCommand(CLI::App& app);
 Command addCompareCommand(CLI::App& app);
 Command addSweepCommand(CLI::App& app);
+Command addViewCommand(CLI::App& app);
 
 }  // namespace narval

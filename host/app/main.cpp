@@ -14,7 +14,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("narval ") + NARVAL_VERSION);
   const std::vector<narval::Command> commands = {narval::addRenderCommand(app), narval::addDevicesCommand(app),
                                                  narval::addMakeCloudCommand(app), narval::addCompareCommand(app),
-                                                 narval::addSweepCommand(app)};
+                                                 narval::addSweepCommand(app),
+                                                 narval::addViewCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,6 +1,6 @@
 // bitmap_font.h: a small hand-made 5x7 bitmap font for labels on figures (ΔE heat-map legends, the
 // JND percentage on JND maps). Covers digits, upper-case letters (lower case draws as upper case),
-// '%', '.', '-', ':', ' ' and a few extras ('+', '/', '(', ')', '=', '_', '?'); any other character
+// '%', '.', '-', ':', ' ' and a few extras ('+', '/', '(', ')', '=', '_', '?', '[', ']', ','); any other character
 // draws as '?'.
 #pragma once
 

@@ -21,10 +21,11 @@ struct RunResult {
 
 class CliFixture : public ::testing::Test {
  protected:
-  // Runs `narval ARGS` in the test's folder; stdout and stderr captured to files.
-  RunResult run(const std::string& args) {
+  // Runs `narval ARGS` in the test's folder (after `launcher`, e.g. "xvfb-run -a", when given);
+  // stdout and stderr captured to files.
+  RunResult run(const std::string& args, const std::string& launcher = "") {
     namespace fs = std::filesystem;
-    const std::string cmd = "cd '" + dir_.string() + "' && '" + std::string(NARVAL_BINARY) + "' " + args +
+    const std::string cmd = "cd '" + dir_.string() + "' && " + launcher + " '" + std::string(NARVAL_BINARY) + "' " + args +
                             " > stdout.txt 2> stderr.txt";
     const int status = std::system(cmd.c_str());
     RunResult r;

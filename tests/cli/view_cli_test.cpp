@@ -1,0 +1,171 @@
+// narval view, run headless from scripts under Xvfb (scripts/setup.sh installs it with Mesa): what P
+// writes is what `narval render` draws from the JSON beside it, bit for bit, for all three
+// algorithms; the screenshot is that frame's PNG byte for byte; frames are counted per resolution
+// while the camera moves; bad input is one line and exit 2 before any window opens.
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/cli_fixture.h"
+#include "cli/fog_scene.h"
+#include "image/image.h"
+
+namespace narval::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Xvfb with a 24-bit screen: the window's pixels are the frame's, exactly.
+const std::string kXvfb = "xvfb-run -a -s '-screen 0 640x480x24'";
+
+class ViewCli : public CliFixture {
+ protected:
+  void SetUp() override {
+    ASSERT_EQ(std::system("command -v xvfb-run > /dev/null"), 0)
+        << "xvfb-run is missing: scripts/setup.sh installs xvfb (the viewer's tests need a display)";
+    // The fog scene as the ray marcher with its multiple-scattering cache, refined in 4 launches.
+    nlohmann::json scene = nlohmann::json::parse(fogSceneJson(64, 48, 12));
+    scene["renderer"]["algorithm"] = "raymarch";
+    scene["renderer"]["raymarch"] = {{"multipleScattering", "cache"},
+                                     {"msCache", {{"resolution", 4}, {"paths", 64}, {"pathsPerLaunch", 16}}}};
+    write("fog.json", scene.dump(2));
+  }
+  nlohmann::json stats(const std::string& name) { return nlohmann::json::parse(readFile(dir_ / name)); }
+  void expectSamePixels(const std::string& a, const std::string& b, const std::vector<std::string>& channels) {
+    const std::vector<ExrChannel> x = readExrChannels((dir_ / a).string(), channels);
+    const std::vector<ExrChannel> y = readExrChannels((dir_ / b).string(), channels);
+    ASSERT_EQ(x.size(), y.size());
+    for (size_t i = 0; i < x.size(); ++i) {
+      ASSERT_EQ(x[i].values.size(), y[i].values.size()) << x[i].name;
+      size_t differ = 0;
+      for (size_t k = 0; k < x[i].values.size(); ++k)
+        differ += std::memcmp(&x[i].values[k], &y[i].values[k], sizeof(float)) != 0;
+      EXPECT_EQ(differ, 0u) << a << " and " << b << ": channel " << x[i].name;
+    }
+  }
+};
+
+TEST_F(ViewCli, SnapshotsAreWhatRenderDrawsFromTheirJson) {
+  write("moves.txt",
+        "frames 1\n"
+        "drag left 25 -8\n"
+        "frames 1\n"
+        "key P            # the cache has 2 of its 4 launches: P completes it first\n"
+        "frames 1\n"
+        "key 3\n"
+        "scroll 1.5\n"
+        "frames 1\n"
+        "key ]\n"
+        "key P\n"
+        "frames 1\n"
+        "key 1\n"
+        "drag right 6 -4\n"
+        "frames 2\n"
+        "key ]\n"
+        "key ]\n"
+        "frames 2\n"
+        "key P\n"
+        "frames 1\n");
+  const RunResult v = run("view fog.json --script moves.txt --screenshot shot.png --target-ms 1e9 --output-dir snaps "
+                          "--stats-json stats.json",
+                          kXvfb);
+  ASSERT_EQ(v.code, 0) << v.err;
+  // Path tracer: a moving frame restarts (1 spp), a still one adds 1 (2), ]] makes it 4 a frame
+  // (6, 10), and the last frame adds the 2 left of the scene's 12.
+  EXPECT_NE(v.out.find("narval view: wrote snaps/fog_view_001.exr, .png and .json (raymarch, 64x48)\n"),
+            std::string::npos) << v.out;
+  EXPECT_NE(v.out.find("narval view: wrote snaps/fog_view_002.exr, .png and .json (lobe, 64x48)\n"),
+            std::string::npos) << v.out;
+  EXPECT_NE(v.out.find("narval view: wrote snaps/fog_view_003.exr, .png and .json (pathtrace, 64x48, 12 spp)\n"),
+            std::string::npos) << v.out;
+  EXPECT_EQ(stats("stats.json")["frames"], 10);
+
+  const std::vector<std::pair<std::string, std::vector<std::string>>> snaps = {
+      {"001", {"R", "G", "B"}},
+      {"002", {"R", "G", "B"}},
+      {"003", {"R", "G", "B", "accum_sum.R", "accum_sum.G", "accum_sum.B", "accum_comp.R", "accum_comp.G",
+               "accum_comp.B"}}};
+  for (const auto& [n, channels] : snaps) {
+    SCOPED_TRACE("snapshot " + n);
+    const std::string json = "snaps/fog_view_" + n + ".json";
+    const nlohmann::json written = nlohmann::json::parse(readFile(dir_ / json));
+    EXPECT_NE(written["camera"]["position"], nlohmann::json::parse(fogSceneJson(64, 48, 12))["camera"]["position"]);
+    const RunResult r = run("render " + json + " -o again_" + n + ".exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    expectSamePixels("snaps/fog_view_" + n + ".exr", "again_" + n + ".exr", channels);
+    EXPECT_EQ(readFile(dir_ / ("snaps/fog_view_" + n + ".png")), readFile(dir_ / ("again_" + n + ".png")));
+  }
+  // The window showed the last frame pixel for pixel.
+  EXPECT_EQ(readFile(dir_ / "shot.png"), readFile(dir_ / "again_003.png"));
+}
+
+TEST_F(ViewCli, MovingFramesAreSmallerAndCountedPerResolution) {
+  write("moves.txt",
+        "frames 2\n"
+        "drag left 10 0\n"
+        "frames 1\n"
+        "hold W 0.1\n"
+        "frames 1\n"
+        "scroll 1\n"
+        "frames 3\n");
+  // A target no frame meets: every frame after a move is a quarter of the size; still frames are
+  // full size (the first frame is full size too: nothing is measured yet).
+  RunResult v = run("view fog.json --script moves.txt --target-ms 1e-6 --stats-json small.json", kXvfb);
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_EQ(stats("small.json")["frames_per_resolution"], nlohmann::json({{"64x48", 4}, {"16x12", 3}}));
+  EXPECT_NE(v.out.find("narval view: 7 frames (16x12: 3, 64x48: 4) on "), std::string::npos) << v.out;
+  // A target every frame meets: all full size. --frames adds still frames after the script.
+  v = run("view fog.json --script moves.txt --target-ms 1e9 --frames 9 --stats-json large.json", kXvfb);
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_EQ(stats("large.json")["frames_per_resolution"], nlohmann::json({{"64x48", 9}}));
+}
+
+TEST_F(ViewCli, LiveErrorAgainstTheReferenceAtItsPoseOnly) {
+  ASSERT_EQ(run("render fog.json -o reference.exr").code, 0);
+  // Five frames: the viewer refines the cache one launch a frame, complete at the fourth.
+  write("still.txt", "frames 5\n");
+  RunResult v = run("view fog.json --reference reference.exr --script still.txt --stats-json at.json", kXvfb);
+  ASSERT_EQ(v.code, 0) << v.err;
+  // The same kernels, settings and cache: the frame is the reference, ΔE 0.
+  EXPECT_EQ(stats("at.json")["reference"], nlohmann::json({{"mean_delta_e76", 0.0}, {"jnd_percent", 0.0}}));
+  write("away.txt", "frames 1\ndrag left 40 0\nframes 1\n");
+  v = run("view fog.json --reference reference.exr --script away.txt --stats-json away.json", kXvfb);
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_FALSE(stats("away.json").contains("reference"));
+}
+
+TEST_F(ViewCli, WithoutADisplayOneLineAndExit2) {
+  const RunResult v = run("view fog.json", "env -u DISPLAY -u WAYLAND_DISPLAY");
+  EXPECT_EQ(v.code, 2);
+  EXPECT_EQ(v.err,
+            "narval: view: no display to open a window on (DISPLAY is not set); run it in a desktop session, or "
+            "headless with a script under Xvfb: xvfb-run -a narval view ...\n");
+}
+
+TEST_F(ViewCli, BadInputIsFoundBeforeAnyWindow) {
+  // No display either: each mistake is reported before the window would be opened.
+  const std::string noDisplay = "env -u DISPLAY -u WAYLAND_DISPLAY";
+  write("bad.txt", "frames 1\nkey Z\n");
+  RunResult v = run("view fog.json --script bad.txt", noDisplay);
+  EXPECT_EQ(v.code, 2);
+  EXPECT_EQ(v.err, "narval: bad.txt:2: unknown key 'Z' (keys: 1 2 3 [ ] P R H F)\n");
+  v = run("view fog.json --script missing.txt", noDisplay);
+  EXPECT_EQ(v.code, 2);
+  EXPECT_EQ(v.err, "narval: missing.txt: cannot open the script\n");
+  v = run("view fog.json --frames 2 --screenshot shot.jpg", noDisplay);
+  EXPECT_EQ(v.code, 2);
+  EXPECT_EQ(v.err, "narval: --screenshot: the screenshot must be a .png file, got 'shot.jpg'\n");
+  v = run("view fog.json --screenshot shot.png", noDisplay);
+  EXPECT_EQ(v.code, 2);
+  EXPECT_EQ(v.err, "narval: --screenshot: needs --script or --frames (the screenshot is of the last frame)\n");
+  ASSERT_EQ(run("render fog.json -o small.exr --resolution 32x24").code, 0);
+  v = run("view fog.json --reference small.exr", noDisplay);
+  EXPECT_EQ(v.code, 2);
+  EXPECT_EQ(v.err, "narval: --reference: small.exr is 32x24; the scene renders 64x48\n");
+  EXPECT_FALSE(fs::exists(dir_ / "shot.png"));
+}
+
+}  // namespace
+}  // namespace narval::test
