@@ -5,6 +5,12 @@
 #include <stdexcept>
 #include <utility>
 
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/matrix.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "render/kernel_features.h"
 #include "scene/input_error.h"
 #include "volume/majorant_grid.h"
@@ -17,22 +23,27 @@ constexpr float kDegToRad = 3.14159265358979323846f / 180.0f;
 nv_float4 f4(float x, float y, float z, float w = 0.0f) { return nv_float4{x, y, z, w}; }
 nv_float4 f4(const Vec3f& v, float w = 0.0f) { return nv_float4{v[0], v[1], v[2], w}; }
 
-struct V3 {
-  float x, y, z;
-};
-V3 sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-float dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 normalize(V3 a) {
-  const float l = std::sqrt(dot(a, a));
-  return {a.x / l, a.y / l, a.z / l};
+// Host-side vectors and matrices are GLM's. Vectors are normalised as v / |v| (not GLM's
+// v · inversesqrt), which keeps the bits of the uploads the kernels' golden images were made from.
+glm::vec3 normalized(const glm::vec3& a) { return a / glm::length(a); }
+glm::vec3 v3(const Vec3f& v) { return {v[0], v[1], v[2]}; }
+nv_float4 f4(const glm::vec3& v, float w = 0.0f) { return nv_float4{v.x, v.y, v.z, w}; }
+
+// nv_affine (row-major 3x4, the kernels' layout) to and from GLM's column-major 4x4 in double.
+glm::dmat4 toGlm(const nv_affine& a) {
+  glm::dmat4 m(1.0);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) m[j][i] = (&a.row[i].x)[j];
+  return m;
 }
-V3 v3(const Vec3f& v) { return {v[0], v[1], v[2]}; }
-V3 apply(const nv_affine& m, V3 p, float w) {
-  const nv_float4* r = m.row;
-  return {r[0].x * p.x + r[0].y * p.y + r[0].z * p.z + r[0].w * w,
-          r[1].x * p.x + r[1].y * p.y + r[1].z * p.z + r[1].w * w,
-          r[2].x * p.x + r[2].y * p.y + r[2].z * p.z + r[2].w * w};
+nv_affine fromGlm(const glm::dmat4& m) {
+  nv_affine a;
+  for (int i = 0; i < 3; ++i) a.row[i] = nv_float4{float(m[0][i]), float(m[1][i]), float(m[2][i]), float(m[3][i])};
+  return a;
+}
+// M · (p, w): a point (w = 1) or a direction (w = 0), in float as the kernels would.
+glm::vec3 apply(const nv_affine& m, const glm::vec3& p, float w) {
+  return glm::vec3(glm::mat4(toGlm(m)) * glm::vec4(p, w));
 }
 
 nv_affine fromRows(const float m[3][4]) {
@@ -58,15 +69,14 @@ light_params buildLight(const Primitive& p, const Material& m) {
   // The unit quad [-0.5, 0.5]² in local XY, emitting along local -Z (DESIGN.md, emitters). The
   // emission direction follows the rotation alone: scale changes the extent, not the facing.
   const nv_affine M = transformMatrix(p.transform);
-  const V3 corner = apply(M, {-0.5f, -0.5f, 0.0f}, 1.0f);
-  const V3 eu = apply(M, {1, 0, 0}, 0.0f), ev = apply(M, {0, 1, 0}, 0.0f);
-  const V3 n = normalize(apply(rotationOnly(p.transform), {0, 0, -1}, 0.0f));
-  const V3 area = cross(eu, ev);
+  const glm::vec3 corner = apply(M, {-0.5f, -0.5f, 0.0f}, 1.0f);
+  const glm::vec3 eu = apply(M, {1, 0, 0}, 0.0f), ev = apply(M, {0, 1, 0}, 0.0f);
+  const glm::vec3 n = normalized(apply(rotationOnly(p.transform), {0, 0, -1}, 0.0f));
   l.type = LIGHT_RECTANGLE;
-  l.corner = f4(corner.x, corner.y, corner.z);
-  l.edge_u = f4(eu.x, eu.y, eu.z);
-  l.edge_v = f4(ev.x, ev.y, ev.z);
-  l.normal = f4(n.x, n.y, n.z, std::sqrt(dot(area, area)));
+  l.corner = f4(corner);
+  l.edge_u = f4(eu);
+  l.edge_v = f4(ev);
+  l.normal = f4(n, glm::length(glm::cross(eu, ev)));
   return l;
 }
 
@@ -75,14 +85,14 @@ light_params buildLight(const Primitive& p, const Material& m) {
 camera_params buildCamera(const Scene& scene) {
   const Camera& c = scene.camera;
   camera_params cam{};
-  const V3 pos = v3(c.position);
-  const V3 fwd = normalize(sub(v3(c.lookAt), pos));
-  const V3 right = normalize(cross(fwd, v3(c.up)));
-  const V3 up = cross(right, fwd);
-  cam.position = f4(pos.x, pos.y, pos.z);
-  cam.forward = f4(fwd.x, fwd.y, fwd.z);
-  cam.right = f4(right.x, right.y, right.z);
-  cam.up = f4(up.x, up.y, up.z);
+  const glm::vec3 pos = v3(c.position);
+  const glm::vec3 fwd = normalized(v3(c.lookAt) - pos);
+  const glm::vec3 right = normalized(glm::cross(fwd, v3(c.up)));
+  const glm::vec3 up = glm::cross(right, fwd);
+  cam.position = f4(pos);
+  cam.forward = f4(fwd);
+  cam.right = f4(right);
+  cam.up = f4(up);
   cam.width = scene.renderer.width;
   cam.height = scene.renderer.height;
   cam.aspect = float(cam.width) / float(cam.height);
@@ -96,61 +106,25 @@ nv_affine transformMatrix(const Transform& t) {
   const float ax = t.rotation[0] * kDegToRad, ay = t.rotation[1] * kDegToRad, az = t.rotation[2] * kDegToRad;
   const float cx = std::cos(ax), sx = std::sin(ax), cy = std::cos(ay), sy = std::sin(ay);
   const float cz = std::cos(az), sz = std::sin(az);
-  // R = Rz · Ry · Rx
-  const float R[3][3] = {{cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
-                         {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
-                         {-sy, cy * sx, cy * cx}};
-  float m[3][4];
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) m[i][j] = R[i][j] * t.scale[j];
-    m[i][3] = t.position[i];
-  }
-  return fromRows(m);
+  // R = Rz · Ry · Rx written out (GLM's rotate would round differently), by columns.
+  const glm::mat3 R(glm::vec3(cz * cy, sz * cy, -sy), glm::vec3(cz * sy * sx - sz * cx, sz * sy * sx + cz * cx, cy * sx),
+                    glm::vec3(cz * sy * cx + sz * sx, sz * sy * cx - cz * sx, cy * cx));
+  glm::mat4 M(R * glm::mat3(glm::scale(glm::mat4(1.0f), v3(t.scale))));
+  M[3] = glm::vec4(v3(t.position), 1.0f);
+  return fromGlm(glm::dmat4(M));
 }
 
-nv_affine affineMultiply(const nv_affine& a, const nv_affine& b) {
-  auto get = [](const nv_affine& m, int i, int j) {
-    const nv_float4& r = m.row[i];
-    return j == 0 ? r.x : j == 1 ? r.y : j == 2 ? r.z : r.w;
-  };
-  float m[3][4];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 4; ++j) {
-      double s = j == 3 ? get(a, i, 3) : 0.0;
-      for (int k = 0; k < 3; ++k) s += double(get(a, i, k)) * get(b, k, j);
-      m[i][j] = float(s);
-    }
-  return fromRows(m);
-}
+nv_affine affineMultiply(const nv_affine& a, const nv_affine& b) { return fromGlm(toGlm(a) * toGlm(b)); }
 
 nv_affine affineInverse(const nv_affine& a) {
-  const nv_float4* r = a.row;
-  const double m[3][3] = {{r[0].x, r[0].y, r[0].z}, {r[1].x, r[1].y, r[1].z}, {r[2].x, r[2].y, r[2].z}};
-  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  const glm::dmat4 m = toGlm(a);
+  const glm::dmat3 linear(m);
+  const double det = glm::determinant(linear);
   if (!(std::fabs(det) > 1e-30) || !std::isfinite(det)) throw std::domain_error("singular transform");
-  double inv[3][3];
-  inv[0][0] = (m[1][1] * m[2][2] - m[1][2] * m[2][1]) / det;
-  inv[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det;
-  inv[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det;
-  inv[1][0] = (m[1][2] * m[2][0] - m[1][0] * m[2][2]) / det;
-  inv[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det;
-  inv[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det;
-  inv[2][0] = (m[1][0] * m[2][1] - m[1][1] * m[2][0]) / det;
-  inv[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det;
-  inv[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det;
-  const double t[3] = {r[0].w, r[1].w, r[2].w};
-  float out[3][4];
-  for (int i = 0; i < 3; ++i) {
-    double s = 0;
-    for (int j = 0; j < 3; ++j) {
-      out[i][j] = float(inv[i][j]);
-      s -= inv[i][j] * t[j];
-    }
-    out[i][3] = float(s);
-  }
-  return fromRows(out);
+  const glm::dmat3 inverse = glm::inverse(linear);
+  glm::dmat4 out(inverse);
+  out[3] = glm::dvec4(-(inverse * glm::dvec3(m[3])), 1.0);
+  return fromGlm(out);
 }
 
 bool mediumWorldBounds(const DeviceScene& ds, float lo[3], float hi[3]) {
