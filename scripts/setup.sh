@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs missing Debian packages (as root or with passwordless sudo; otherwise prints the apt-get
 # line and stops): the toolchain, PoCL, the libraries, and for the viewer GLFW, GLM and OpenGL, with
-# Xvfb and Mesa for its headless tests. Then configures and builds Release into build/ (binary
+# Xvfb, Mesa and xdotool for its headless tests. Then configures and builds Release into build/ (binary
 # build/narval) and generates the default cloud.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,7 +11,7 @@ packages=(build-essential cmake pkg-config
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libopenexr-dev libpng-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-dev
-  libglfw3-dev libglm-dev libgl1-mesa-dri libglx-mesa0 xvfb xauth)
+  libglfw3-dev libglm-dev libgl1-mesa-dri libglx-mesa0 xvfb xauth xdotool)
 
 missing=()
 for p in "${packages[@]}"; do

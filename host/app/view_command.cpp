@@ -128,7 +128,7 @@ Command addViewCommand(CLI::App& app) {
   sub->add_option("--set", a->sets, "Override a scene value: dotted.path=value (repeatable)");
   sub->add_option("--resolution", a->resolution, "WIDTHxHEIGHT of the full-size frames");
   sub->add_option("--target-ms", a->targetMs,
-                  "While the camera moves, render at 1/2 or 1/4 resolution so that a frame takes about this "
+                  "While the camera moves, render at 1/2, 1/4 or 1/8 resolution so that a frame takes about this "
                   "long (default 50)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--script", a->script,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 
 #include <glm/geometric.hpp>
 
@@ -19,7 +20,7 @@ namespace fs = std::filesystem;
 namespace narval {
 namespace {
 
-constexpr int kLevels[] = {1, 2, 4};  // resolution divisors while moving
+constexpr int kLevels[] = {1, 2, 4, 8};  // resolution divisors while moving
 
 const char* const kHelp[] = {
     "LEFT DRAG: ORBIT   RIGHT DRAG: PAN   WHEEL: ZOOM",
@@ -151,7 +152,7 @@ int ViewerSession::chooseLevel() const {
   const double fullPixels = double(scene_.renderer.width) * scene_.renderer.height;
   for (const int level : kLevels)
     if (it->second * perSample * fullPixels / (level * level) <= options_.targetMs) return level;
-  return kLevels[2];
+  return kLevels[std::size(kLevels) - 1];
 }
 
 RealtimeRenderer& ViewerSession::realtime(const Scene& view) {

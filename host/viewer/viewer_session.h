@@ -23,7 +23,7 @@
 namespace narval {
 
 struct ViewerOptions {
-  // While the camera moves, the resolution is divided by 2 or 4 so that a frame is predicted to take
+  // While the camera moves, the resolution is divided by 2, 4 or 8 so that a frame is predicted to take
   // at most this many milliseconds (kernel time, from the frames so far); still frames are full size.
   double targetMs = 50;
   std::string outputDir = ".";          // where P writes its EXR, PNG and scene JSON

@@ -24,9 +24,12 @@ class CliFixture : public ::testing::Test {
   // Runs `narval ARGS` in the test's folder (after `launcher`, e.g. "xvfb-run -a", when given);
   // stdout and stderr captured to files.
   RunResult run(const std::string& args, const std::string& launcher = "") {
+    return runCommand(launcher + " '" + std::string(NARVAL_BINARY) + "' " + args);
+  }
+  // Runs a shell command line in the test's folder, output captured as run() does.
+  RunResult runCommand(const std::string& command) {
     namespace fs = std::filesystem;
-    const std::string cmd = "cd '" + dir_.string() + "' && " + launcher + " '" + std::string(NARVAL_BINARY) + "' " + args +
-                            " > stdout.txt 2> stderr.txt";
+    const std::string cmd = "cd '" + dir_.string() + "' && " + command + " > stdout.txt 2> stderr.txt";
     const int status = std::system(cmd.c_str());
     RunResult r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -3,6 +3,7 @@
 // algorithms; the screenshot is that frame's PNG byte for byte; frames are counted per resolution
 // while the camera moves; bad input is one line and exit 2 before any window opens.
 #include <cstdlib>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 
@@ -110,12 +111,12 @@ TEST_F(ViewCli, MovingFramesAreSmallerAndCountedPerResolution) {
         "frames 1\n"
         "scroll 1\n"
         "frames 3\n");
-  // A target no frame meets: every frame after a move is a quarter of the size; still frames are
+  // A target no frame meets: every frame after a move is an eighth of the size; still frames are
   // full size (the first frame is full size too: nothing is measured yet).
   RunResult v = run("view fog.json --script moves.txt --target-ms 1e-6 --stats-json small.json", kXvfb);
   ASSERT_EQ(v.code, 0) << v.err;
-  EXPECT_EQ(stats("small.json")["frames_per_resolution"], nlohmann::json({{"64x48", 4}, {"16x12", 3}}));
-  EXPECT_NE(v.out.find("narval view: 7 frames (16x12: 3, 64x48: 4) on "), std::string::npos) << v.out;
+  EXPECT_EQ(stats("small.json")["frames_per_resolution"], nlohmann::json({{"64x48", 4}, {"8x6", 3}}));
+  EXPECT_NE(v.out.find("narval view: 7 frames (64x48: 4, 8x6: 3) on "), std::string::npos) << v.out;
   // A target every frame meets: all full size. --frames adds still frames after the script.
   v = run("view fog.json --script moves.txt --target-ms 1e9 --frames 9 --stats-json large.json", kXvfb);
   ASSERT_EQ(v.code, 0) << v.err;
@@ -134,6 +135,39 @@ TEST_F(ViewCli, LiveErrorAgainstTheReferenceAtItsPoseOnly) {
   v = run("view fog.json --reference reference.exr --script away.txt --stats-json away.json", kXvfb);
   ASSERT_EQ(v.code, 0) << v.err;
   EXPECT_FALSE(stats("away.json").contains("reference"));
+}
+
+// The window's own input path, driven by real X events (xdotool, XTEST): a left drag of 20 pixels
+// orbits by 5 degrees, the key P writes a snapshot. The path tracer goes idle at its 4 spp, so the
+// viewer waits for the events; --frames 9 ends it (4 frames, 4 after the drag, 1 for P).
+TEST_F(ViewCli, MouseAndKeysOfTheWindowDriveTheSameControls) {
+  ASSERT_EQ(std::system("command -v xdotool > /dev/null"), 0) << "xdotool is missing: scripts/setup.sh installs it";
+  write("drive.sh",
+        "'" + std::string(NARVAL_BINARY) +
+            "' view fog.json --algorithm pathtrace --set renderer.spp=4 --frames 9 --target-ms 1e9 "
+            "--output-dir snaps --stats-json stats.json > view.out 2> view.err &\n"
+            "viewer=$!\n"
+            "window=$(xdotool search --sync --onlyvisible --name 'narval view' | head -n 1)\n"
+            "sleep 1\n"
+            "xdotool mousemove --window \"$window\" 20 24 mousedown 1\n"
+            "xdotool mousemove --window \"$window\" 40 24 mouseup 1\n"
+            "sleep 1\n"
+            "xdotool key p\n"
+            "wait $viewer\n");
+  const RunResult v = runCommand(kXvfb + " sh drive.sh");
+  ASSERT_EQ(v.code, 0) << v.err << readFile(dir_ / "view.err");
+  const nlohmann::json written = nlohmann::json::parse(readFile(dir_ / "snaps/fog_view_001.json"));
+  // Yaw 5 degrees about +y of the camera at (0, 0, -6) looking at the origin: the offset rotates by
+  // -5 degrees, x = -6 · sin(-5°) = 0.52293, z = -6 · cos(5°) = -5.97717.
+  const nlohmann::json& p = written["camera"]["position"];
+  EXPECT_NEAR(p[0].get<double>(), 6.0 * std::sin(5.0 * M_PI / 180.0), 1e-4) << p;
+  EXPECT_NEAR(p[1].get<double>(), 0.0, 1e-5) << p;
+  EXPECT_NEAR(p[2].get<double>(), -6.0 * std::cos(5.0 * M_PI / 180.0), 1e-4) << p;
+  EXPECT_EQ(written["renderer"]["spp"], 4);
+  EXPECT_EQ(stats("stats.json")["frames"], 9);
+  const RunResult r = run("render snaps/fog_view_001.json -o again.exr");
+  ASSERT_EQ(r.code, 0) << r.err;
+  expectSamePixels("snaps/fog_view_001.exr", "again.exr", {"R", "G", "B", "accum_sum.R", "accum_comp.R"});
 }
 
 TEST_F(ViewCli, WithoutADisplayOneLineAndExit2) {
