@@ -16,6 +16,11 @@ std::pair<int, int> parseSize(const std::string& text, const std::string& what) 
   return {std::stoi(m[1]), std::stoi(m[2])};
 }
 
+std::string resolutionOverride(const std::string& text) {
+  const auto [w, h] = parseSize(text, "--resolution");
+  return "renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]";
+}
+
 const DenseGrid* loadSceneGrid(const Scene& scene, DenseGrid& storage) {
   for (const Primitive& p : scene.primitives) {
     if (p.type != PrimitiveType::Volume) continue;

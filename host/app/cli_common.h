@@ -14,6 +14,9 @@ namespace narval {
 // "WxH" -> {W, H} (positive); `what` names the option in the InputError.
 std::pair<int, int> parseSize(const std::string& text, const std::string& what);
 
+// --resolution WxH as the scene override "renderer.resolution=[W,H]" (parseSize's errors name the flag).
+std::string resolutionOverride(const std::string& text);
+
 // Loads the grid of the scene's volume primitive into `storage` and returns it, or null when the
 // scene has no volume or a homogeneous one. Throws InputError from the grid loader.
 const DenseGrid* loadSceneGrid(const Scene& scene, DenseGrid& storage);

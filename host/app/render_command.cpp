@@ -44,10 +44,7 @@ std::vector<std::string> overridesFrom(const RenderArgs& a) {
   if (a.seed >= 0) o.push_back("renderer.seed=" + std::to_string(a.seed));
   if (!a.algorithm.empty()) o.push_back("renderer.algorithm=\"" + a.algorithm + "\"");
   if (!a.storage.empty()) o.push_back("renderer.storage=\"" + a.storage + "\"");
-  if (!a.resolution.empty()) {
-    const auto [w, h] = parseSize(a.resolution, "--resolution");
-    o.push_back("renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]");
-  }
+  if (!a.resolution.empty()) o.push_back(resolutionOverride(a.resolution));
   return o;
 }
 

@@ -70,10 +70,7 @@ int runSweepCommand(const SweepArgs& a) {
   if (sweepSpp && hasBounces) overrides.push_back("renderer.bounces=" + std::to_string(parseSingle(a.bounces, "--bounces", 0)));
   if (!sweepSpp && hasSpp) overrides.push_back("renderer.spp=" + std::to_string(parseSingle(a.spp, "--spp", 1)));
   if (a.seed >= 0) overrides.push_back("renderer.seed=" + std::to_string(a.seed));
-  if (!a.resolution.empty()) {
-    const auto [w, h] = parseSize(a.resolution, "--resolution");
-    overrides.push_back("renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]");
-  }
+  if (!a.resolution.empty()) overrides.push_back(resolutionOverride(a.resolution));
   Scene scene = loadScene(a.scene, overrides);
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
   if (scene.renderer.algorithm != "pathtrace" && a.algorithm.empty())

@@ -30,10 +30,7 @@ struct ViewArgs {
 int runView(const ViewArgs& a) {
   std::vector<std::string> overrides = a.sets;
   if (!a.algorithm.empty()) overrides.push_back("renderer.algorithm=\"" + a.algorithm + "\"");
-  if (!a.resolution.empty()) {
-    const auto [w, h] = parseSize(a.resolution, "--resolution");
-    overrides.push_back("renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]");
-  }
+  if (!a.resolution.empty()) overrides.push_back(resolutionOverride(a.resolution));
   Scene scene = loadScene(a.scene, overrides);
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
   const auto [lx, ly] = parseSize(a.localSize, "--local-size");

@@ -319,7 +319,7 @@ std::string ViewerSession::title() const {
                   fixed(lastMs_, 1) + " ms | " + sizeName(lastWidth_, lastHeight_) + " | " + std::to_string(spp_) +
                   " spp | " + rt_.selected.info.name;
   if (liveError_.valid)
-    t += " | dE76 " + fixed(liveError_.meanDeltaE76, 2) + ", JND " + fixed(liveError_.jndPercent, 1) + "%";
+    t += " | ΔE76 " + fixed(liveError_.meanDeltaE76, 2) + ", JND " + fixed(liveError_.jndPercent, 1) + "%";
   return t;
 }
 
