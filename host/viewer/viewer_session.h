@@ -50,7 +50,7 @@ class ViewerSession {
   // The last frame as shown: full resolution (a reduced frame scaled up by pixel replication),
   // display-transformed as the PNG is, with the help overlay when it is on.
   const ImageRGB8& display() const { return display_; }
-  // "narval view: cloud.json | raymarch | 86.7 ms | 320x240 | 1 spp | DEVICE | dE76 1.09, JND 15.3%"
+  // "narval view: cloud.json | raymarch | 86.7 ms | 320x240 | 1 spp | DEVICE | ΔE76 1.09, JND 15.3%"
   std::string title() const;
   // Frames rendered per resolution ("320x240" → count), in this run.
   const std::map<std::string, int>& framesPerResolution() const { return framesPerResolution_; }
