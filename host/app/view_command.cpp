@@ -69,7 +69,7 @@ int runView(const ViewArgs& a) {
   options.render.localSizeX = lx;
   options.render.localSizeY = ly;
 
-  ViewerWindow window(scene.renderer.width, scene.renderer.height, "narval view: " + a.scene);
+  ViewerWindow window(scene.renderer.width, scene.renderer.height, "narval view: " + a.scene, run.frames > 0);
   DenseGrid gridStorage;
   const DenseGrid* grid = loadSceneGrid(scene, gridStorage);
   ClRuntime rt(a.device);

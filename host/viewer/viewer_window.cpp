@@ -30,10 +30,13 @@ bool hasDisplayVariable() {
 
 }  // namespace
 
-ViewerWindow::ViewerWindow(int width, int height, const std::string& title) {
-  if (!hasDisplayVariable())
-    throw InputError("view: no display to open a window on (DISPLAY is not set); run it in a desktop session, "
-                     "or headless with a script under Xvfb: xvfb-run -a narval view ...");
+ViewerWindow::ViewerWindow(int width, int height, const std::string& title, bool headless) {
+  if (!hasDisplayVariable()) {
+    if (!headless)
+      throw InputError("view: no display to open a window on (DISPLAY is not set); run it in a desktop session, "
+                       "or headless with --script or --frames (narval then starts Xvfb itself)");
+    xvfb_ = std::make_unique<PrivateXvfb>(width, height);
+  }
   glfwSetErrorCallback(onGlfwError);
   if (!glfwInit()) throw InputError("view: cannot open a window: " + glfwLastError());
   glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);

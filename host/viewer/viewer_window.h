@@ -7,6 +7,9 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+
+#include "viewer/private_xvfb.h"
 #include "viewer/viewer_input.h"
 #include "viewer/viewer_session.h"
 
@@ -16,9 +19,10 @@ namespace narval {
 
 class ViewerWindow {
  public:
-  // Opens a window of width x height pixels. Throws InputError (one line, exit 2) when there is no
-  // display to open it on: DISPLAY and WAYLAND_DISPLAY unset, or GLFW's reason.
-  ViewerWindow(int width, int height, const std::string& title);
+  // Opens a window of width x height pixels. Without a display (DISPLAY and WAYLAND_DISPLAY unset), a
+  // `headless` run (scripted, or a number of frames) starts an Xvfb of its own (PrivateXvfb);
+  // otherwise, or without Xvfb, it throws InputError (one line, exit 2), as for GLFW's failures.
+  ViewerWindow(int width, int height, const std::string& title, bool headless);
   ~ViewerWindow();
   ViewerWindow(const ViewerWindow&) = delete;
   ViewerWindow& operator=(const ViewerWindow&) = delete;
@@ -43,6 +47,7 @@ class ViewerWindow {
   static void onCursor(GLFWwindow* w, double x, double y);
   static void onScroll(GLFWwindow* w, double dx, double dy);
 
+  std::unique_ptr<PrivateXvfb> xvfb_;  // first declared, so it outlives the window
   GLFWwindow* window_ = nullptr;
   unsigned int texture_ = 0;
   std::vector<ViewerInput> pending_;  // the user's inputs since the last frame

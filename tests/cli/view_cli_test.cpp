@@ -117,8 +117,10 @@ TEST_F(ViewCli, MovingFramesAreSmallerAndCountedPerResolution) {
   ASSERT_EQ(v.code, 0) << v.err;
   EXPECT_EQ(stats("small.json")["frames_per_resolution"], nlohmann::json({{"64x48", 4}, {"8x6", 3}}));
   EXPECT_NE(v.out.find("narval view: 7 frames (64x48: 4, 8x6: 3) on "), std::string::npos) << v.out;
-  // A target every frame meets: all full size. --frames adds still frames after the script.
-  v = run("view fog.json --script moves.txt --target-ms 1e9 --frames 9 --stats-json large.json", kXvfb);
+  // A target every frame meets: all full size. --frames adds still frames after the script. No
+  // display this time: the headless run starts an Xvfb of its own.
+  v = run("view fog.json --script moves.txt --target-ms 1e9 --frames 9 --stats-json large.json",
+          "env -u DISPLAY -u WAYLAND_DISPLAY");
   ASSERT_EQ(v.code, 0) << v.err;
   EXPECT_EQ(stats("large.json")["frames_per_resolution"], nlohmann::json({{"64x48", 9}}));
 }
@@ -171,11 +173,19 @@ TEST_F(ViewCli, MouseAndKeysOfTheWindowDriveTheSameControls) {
 }
 
 TEST_F(ViewCli, WithoutADisplayOneLineAndExit2) {
-  const RunResult v = run("view fog.json", "env -u DISPLAY -u WAYLAND_DISPLAY");
+  // Interactive: a window nobody can see is no use.
+  RunResult v = run("view fog.json", "env -u DISPLAY -u WAYLAND_DISPLAY");
   EXPECT_EQ(v.code, 2);
   EXPECT_EQ(v.err,
             "narval: view: no display to open a window on (DISPLAY is not set); run it in a desktop session, or "
-            "headless with a script under Xvfb: xvfb-run -a narval view ...\n");
+            "headless with --script or --frames (narval then starts Xvfb itself)\n");
+  // Headless, but no Xvfb on PATH to start.
+  v = run("view fog.json --frames 1 --screenshot shot.png", "env -u DISPLAY -u WAYLAND_DISPLAY PATH=/nonexistent");
+  EXPECT_EQ(v.code, 2);
+  EXPECT_EQ(v.err,
+            "narval: view: no display to open a window on (DISPLAY is not set) and no Xvfb to start for a headless "
+            "run (Debian: apt-get install xvfb)\n");
+  EXPECT_FALSE(fs::exists(dir_ / "shot.png"));
 }
 
 TEST_F(ViewCli, BadInputIsFoundBeforeAnyWindow) {
