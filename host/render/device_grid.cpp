@@ -80,12 +80,6 @@ GridStorage chooseGridStorage(GridStorage requested, const DeviceInfo& device, c
   return GridStorage::Bricks;
 }
 
-std::string gridStorageBuildOption(GridStorage storage) {
-  if (storage == GridStorage::Buffer) return "-DGRID_STORAGE_BUFFER";
-  if (storage == GridStorage::Bricks) return "-DGRID_STORAGE_BRICKS";
-  return "";
-}
-
 size_t gridBufferBytes(const DenseGrid& grid) { return (GRID_BUFFER_HEADER + grid.voxelCount()) * sizeof(float); }
 
 cl::Image3D uploadGridImage(ClRuntime& rt, const DenseGrid& grid) {

@@ -37,9 +37,6 @@ GridStorage chooseGridStorage(GridStorage requested, const DeviceInfo& device, c
 bool gridFitsImage(const DeviceInfo& device, const DenseGrid& grid, std::string* why = nullptr);
 bool gridFitsBuffer(const DeviceInfo& device, const DenseGrid& grid, std::string* why = nullptr);
 
-// The -D option that builds a kernel for `storage`: "" for the image (the default in grid.h),
-// "-DGRID_STORAGE_BUFFER", "-DGRID_STORAGE_BRICKS". `storage` must be resolved (not Auto).
-std::string gridStorageBuildOption(GridStorage storage);
 
 // A 3D image. Throws InputError naming the grid's file when the device has no image support or
 // the grid exceeds its 3D image size or largest allocation; the message names renderer.storage

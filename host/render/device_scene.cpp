@@ -5,6 +5,7 @@
 
 #include "render/device_allocation.h"
 #include "render/device_grid.h"
+#include "render/kernel_features.h"
 
 namespace narval {
 
@@ -37,20 +38,22 @@ DeviceSceneBuffers::DeviceSceneBuffers(ClRuntime& rt, const Scene& s, const Dens
     gridImage = uploadGridImage(rt, *scene.grid);
     scene.gridBytes = scene.grid->voxelCount() * sizeof(float);
   }
-  const std::string option = gridStorageBuildOption(storage);
-  if (!option.empty()) scene.buildOptions += (scene.buildOptions.empty() ? "" : " ") + option;
 }
 
-void DeviceSceneBuffers::bind(cl::Kernel& kernel) const {
-  kernel.setArg(0, sceneBuf);
-  kernel.setArg(1, lightBuf);
+std::string DeviceSceneBuffers::buildOptions(const std::string& majorant, bool counters) const {
+  return kernelBuildOptions(scene, KernelBuild{storage, majorant, counters});
+}
+
+void DeviceSceneBuffers::bind(NamedKernel& kernel) const {
+  kernel.set("scene", sceneBuf);
+  kernel.set("lights", lightBuf);
   if (!scene.grid)
-    kernel.setArg(2, cl_int(0));
+    kernel.set("grid", cl_int(0));
   else if (storage == GridStorage::Buffer || storage == GridStorage::Bricks)
-    kernel.setArg(2, gridBuffer);
+    kernel.set("grid", gridBuffer);
   else
-    kernel.setArg(2, gridImage);
-  kernel.setArg(3, majorantBuf);
+    kernel.set("grid", gridImage);
+  kernel.set("grid_majorants", majorantBuf);
 }
 
 }  // namespace narval

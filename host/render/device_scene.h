@@ -4,12 +4,13 @@
 #pragma once
 
 #include "cl/cl_runtime.h"
+#include "cl/kernel_args.h"
 #include "render/scene_upload.h"
 
 namespace narval {
 
 struct DeviceSceneBuffers {
-  DeviceScene scene;  // buildOptions include the grid storage's -D option
+  DeviceScene scene;
   // renderer.storage resolved for the device and the grid (chooseGridStorage: auto falls back to
   // bricks, with a warning in scene.warnings, when its choice cannot hold the grid): what the
   // kernels are built for and the grid is uploaded as. Without a grid neither is used
@@ -22,10 +23,12 @@ struct DeviceSceneBuffers {
   size_t bricks = 0, bricksOccupied = 0;
 
   DeviceSceneBuffers(ClRuntime& rt, const Scene& s, const DenseGrid* grid);
-  // Sets kernel arguments 0 (scene), 1 (lights), 2 (grid image or buffer, or an unused int) and
-  // 3 (majorant cells); kernel-specific arguments start at kFirstFreeArg.
-  void bind(cl::Kernel& kernel) const;
-  static constexpr cl_uint kFirstFreeArg = 4;
+  // Sets the arguments every narval kernel starts with: scene, lights, grid (image or buffer, or an
+  // unused int) and grid_majorants (cl/kernel_args.h).
+  void bind(NamedKernel& kernel) const;
+  // The -D options of a kernel on this scene and storage (kernelBuildOptions; the path tracer adds
+  // its majorant and counters).
+  std::string buildOptions(const std::string& majorant = "", bool counters = false) const;
 };
 
 }  // namespace narval

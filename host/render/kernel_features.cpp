@@ -2,8 +2,19 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <stdexcept>
 
 namespace narval {
+namespace {
+
+// `base` and `extra` joined by a space (either may be empty).
+std::string joinBuildOptions(const std::string& base, const std::string& extra) {
+  if (base.empty()) return extra;
+  if (extra.empty()) return base;
+  return base + " " + extra;
+}
+
+}  // namespace
 
 std::string sceneFeatureOptions(const DeviceScene& ds) {
   const scene_params& sp = ds.params;
@@ -24,6 +35,34 @@ std::string sceneFeatureOptions(const DeviceScene& ds) {
   else if (points == 0)
     add("-DLIGHTS_RECT_ONLY");
   if (!(sp.camera.lens_radius > 0.0f)) add("-DCAMERA_PINHOLE");
+  return o;
+}
+
+std::string sceneBuildOptions(const DeviceScene& ds) {
+  const scene_params& sp = ds.params;
+  std::string o = (!sp.has_medium || !ds.grid) ? "-DMEDIUM_HOMOGENEOUS" : "";
+  if (kernelSpecialisationEnabled()) o = joinBuildOptions(o, sceneFeatureOptions(ds));
+  return o;
+}
+
+std::string gridStorageBuildOption(GridStorage storage) {
+  switch (storage) {
+    case GridStorage::Buffer: return "-DGRID_STORAGE_BUFFER";
+    case GridStorage::Bricks: return "-DGRID_STORAGE_BRICKS";
+    case GridStorage::Image: return "";
+    case GridStorage::Auto: break;
+  }
+  throw std::invalid_argument("gridStorageBuildOption: the storage must be resolved (not auto)");
+}
+
+std::string kernelBuildOptions(const DeviceScene& ds, const KernelBuild& build) {
+  std::string o = ds.buildOptions;
+  if (ds.grid) o = joinBuildOptions(o, gridStorageBuildOption(build.storage));
+  if (build.majorant == "global")
+    o = joinBuildOptions(o, "-DMAJORANT_GLOBAL");
+  else if (!build.majorant.empty() && build.majorant != "grid")
+    throw std::invalid_argument("kernelBuildOptions: unknown majorant '" + build.majorant + "'");
+  if (build.counters) o = joinBuildOptions(o, "-DCOUNTERS");
   return o;
 }
 

@@ -1,7 +1,11 @@
-// kernel_features.h: scene specialisation ("model only what a scene needs", DESIGN.md). The -D
-// options that fix, at build time, what the scene does not vary, so the OpenCL compiler folds the
-// runtime branches away (the program cache keys on the options, so each variant is built once):
+// kernel_features.h: every -D option a narval kernel is built with comes from here
+// (kernelBuildOptions): what the scene needs and the choices of the driver.
 //
+// Scene specialisation ("model only what a scene needs", DESIGN.md): the options that fix, at
+// build time, what the scene does not vary, so the OpenCL compiler folds the runtime branches away
+// (the program cache keys on the options, so each variant is built once):
+//
+//   -DMEDIUM_HOMOGENEOUS                         no grid: density 1 in the box      (grid.h)
 //   -DPHASE_FIXED_ISOTROPIC / -DPHASE_FIXED_HG  the medium's phase function      (phase.h)
 //   -DMEDIUM_GREY / -DMEDIUM_CHROMATIC           σ grey or not: analogue walk or
 //                                                spectral tracking only             (tracking.h)
@@ -16,7 +20,14 @@
 // runtime branches (host-compiled headers always do).
 //
 // NARVAL_GENERIC=1 in the environment turns specialisation off (for measurement and debugging:
-// bench/specialisation.sh); it is read at every buildDeviceScene.
+// bench/specialisation.sh); it is read at every buildDeviceScene. MEDIUM_HOMOGENEOUS is not a
+// specialisation (the kernel's grid argument is an int then) and stays.
+//
+// The driver's choices, after those:
+//   -DGRID_STORAGE_BUFFER / -DGRID_STORAGE_BRICKS  the grid as a buffer or bricks (image: none)
+//                                                  (grid.h; render/device_grid.h chooses)
+//   -DMAJORANT_GLOBAL                            path tracer: one majorant   (tracking.h)
+//   -DCOUNTERS                                   path tracer: collision counts (pathtrace.cl)
 #pragma once
 
 #include <string>
@@ -24,6 +35,26 @@
 #include "render/scene_upload.h"
 
 namespace narval {
+
+// What a driver builds a kernel for, beyond the scene.
+struct KernelBuild {
+  GridStorage storage = GridStorage::Image;  // resolved (not Auto); ignored without a grid
+  std::string majorant;                      // the path tracer's: "grid", "global"; "" otherwise
+  bool counters = false;                     // the path tracer's -DCOUNTERS
+};
+
+// All the -D options for a kernel on `ds` built as `build`, space-separated, in the order of the
+// tables above: the scene's (ds.buildOptions: homogeneous, then its features), then the storage
+// (with a grid), the majorant and the counters.
+std::string kernelBuildOptions(const DeviceScene& ds, const KernelBuild& build);
+
+// The scene's part: -DMEDIUM_HOMOGENEOUS without a grid, then sceneFeatureOptions unless
+// NARVAL_GENERIC turns specialisation off (what buildDeviceScene stores in ds.buildOptions).
+std::string sceneBuildOptions(const DeviceScene& ds);
+
+// The -D option that builds a kernel for `storage`: "" for the image (the default in grid.h),
+// "-DGRID_STORAGE_BUFFER", "-DGRID_STORAGE_BRICKS". `storage` must be resolved (not Auto).
+std::string gridStorageBuildOption(GridStorage storage);
 
 // The feature options of `ds`, space-separated in the order of the table above ("" for none).
 std::string sceneFeatureOptions(const DeviceScene& ds);

@@ -42,7 +42,7 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   // Everything a slab depends on besides its light. The grid is identified by its address: a
   // DeviceSceneBuffers keeps its grid for its life, and a new scene makes a new one.
   const std::string key = rawBytes(dev.scene.params.medium) + rawBytes(dev.scene.grid) + rawBytes(c) +
-                          rawBytes(params.shadow_steps) + rawBytes(params.shadow_area_samples) + dev.scene.buildOptions +
+                          rawBytes(params.shadow_steps) + rawBytes(params.shadow_area_samples) + dev.buildOptions() +
                           rawBytes(numLights);
   const bool all = key != mediumKey_;
   if (all) {
@@ -51,8 +51,8 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
                               "a light-transmittance cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
                                   "x" + std::to_string(c.nz) + " nodes for " + std::to_string(numLights) + " lights"};
     buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site);
-    program_ = buildProgram(rt, "light_cache.cl", dev.scene.buildOptions);
-    kernel_ = cl::Kernel(program_, "light_cache_build");
+    program_ = buildProgram(rt, "light_cache.cl", dev.buildOptions());
+    kernel_ = NamedKernel(program_, "light_cache_build");
     statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
     lights_.assign(size_t(numLights), light_params{});
   }
@@ -64,14 +64,13 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   paramBuf_ = constantBuffer(rt, params);
   rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
   dev.bind(kernel_);
-  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
-  kernel_.setArg(arg + 0, paramBuf_);
-  kernel_.setArg(arg + 2, buffer_);
-  kernel_.setArg(arg + 3, statusBuf_);
+  kernel_.set("params", paramBuf_);
+  kernel_.set("cache", buffer_);
+  kernel_.set("status_word", statusBuf_);
   for (int l : stale) {
-    kernel_.setArg(arg + 1, cl_int(l));
+    kernel_.set("light", cl_int(l));
     buildMs_ +=
-        launchOverNodes(rt, kernel_, nodes, "the light-transmittance cache", deviceSceneBytes(dev.scene) + bytes_);
+        launchOverNodes(rt, kernel_.get(), nodes, "the light-transmittance cache", deviceSceneBytes(dev.scene) + bytes_);
     lights_[size_t(l)] = dev.scene.lights[size_t(l)];
     ++slabsBuilt_;
   }

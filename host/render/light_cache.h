@@ -55,7 +55,7 @@ class DeviceLightCache {
   std::string mediumKey_;  // medium, grid identity, layout and shadow steps the slabs were built from
   std::vector<light_params> lights_;  // each slab's light when it was built
   cl::Program program_;
-  cl::Kernel kernel_;
+  NamedKernel kernel_;
   cl::Buffer buffer_, paramBuf_, statusBuf_;
   int slabsBuilt_ = 0;
   double buildMs_ = 0;

@@ -45,16 +45,4 @@ void applyMajorantResolution(ClRuntime& rt, DeviceSceneBuffers& dev, int target,
   }
 }
 
-std::string pathtraceMajorantBuildOptions(const std::string& majorant, bool counters) {
-  std::string o = majorant == "global" ? "-DMAJORANT_GLOBAL" : "";
-  if (counters) o = joinBuildOptions(o, "-DCOUNTERS");
-  return o;
-}
-
-std::string joinBuildOptions(const std::string& base, const std::string& extra) {
-  if (base.empty()) return extra;
-  if (extra.empty()) return base;
-  return base + " " + extra;
-}
-
 }  // namespace narval

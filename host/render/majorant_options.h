@@ -35,11 +35,4 @@ int pathtraceMajorantResolution(const DeviceInfo& device);
 // device. Fills stats.majorantCells.
 void applyMajorantResolution(ClRuntime& rt, DeviceSceneBuffers& dev, int target, RenderStats& stats);
 
-// The path tracer's extra build options for a resolved majorant ("grid" or "global") and counters:
-// "-DMAJORANT_GLOBAL", "-DCOUNTERS", space-separated ("" for the grid without counters).
-std::string pathtraceMajorantBuildOptions(const std::string& majorant, bool counters);
-
-// `base` and `extra` joined by a space (either may be empty).
-std::string joinBuildOptions(const std::string& base, const std::string& extra);
-
 }  // namespace narval

@@ -18,7 +18,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   scene_params pathScene = dev.scene.params;
   pathScene.camera = camera_params{};
   pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
-  std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.scene.buildOptions;
+  std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions();
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
@@ -27,8 +27,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
                                   "x" + std::to_string(c.nz) + " nodes"};
     buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site);
     rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
-    program_ = buildProgram(rt, "ms_cache.cl", dev.scene.buildOptions);
-    kernel_ = cl::Kernel(program_, "ms_cache_build");
+    program_ = buildProgram(rt, "ms_cache.cl", dev.buildOptions());
+    kernel_ = NamedKernel(program_, "ms_cache_build");
     sceneBuf_ = constantBuffer(rt, pathScene);
     statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
     rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
@@ -39,17 +39,16 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   if (paths_ >= targetPaths) return;
   paramBuf_ = constantBuffer(rt, params);
   dev.bind(kernel_);
-  kernel_.setArg(0, sceneBuf_);
-  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
-  kernel_.setArg(arg + 0, paramBuf_);
-  kernel_.setArg(arg + 3, buffer_);
-  kernel_.setArg(arg + 4, statusBuf_);
+  kernel_.set("scene", sceneBuf_);  // the scene the paths see (no camera, one bounce fewer)
+  kernel_.set("params", paramBuf_);
+  kernel_.set("cache", buffer_);
+  kernel_.set("status_word", statusBuf_);
   while (paths_ < targetPaths) {
     const int count = std::min(std::max(1, pathsPerLaunch), targetPaths - paths_);
-    kernel_.setArg(arg + 1, cl_uint(paths_));
-    kernel_.setArg(arg + 2, cl_uint(count));
+    kernel_.set("first", cl_uint(paths_));
+    kernel_.set("count", cl_uint(count));
     buildMs_ +=
-        launchOverNodes(rt, kernel_, nodes, "the multiple-scattering cache", deviceSceneBytes(dev.scene) + bytes_);
+        launchOverNodes(rt, kernel_.get(), nodes, "the multiple-scattering cache", deviceSceneBytes(dev.scene) + bytes_);
     paths_ += count;
   }
   status_ |= readStatusWord(rt, statusBuf_);

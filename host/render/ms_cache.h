@@ -31,7 +31,7 @@ class DeviceMsCache {
  private:
   std::string key_;
   cl::Program program_;
-  cl::Kernel kernel_;
+  NamedKernel kernel_;
   cl::Buffer buffer_, sceneBuf_, paramBuf_, statusBuf_;
   int paths_ = 0, rebuilds_ = 0;
   double buildMs_ = 0;

@@ -46,9 +46,9 @@ PathtraceRenderer::PathtraceRenderer(ClRuntime& rt, const Scene& scene, const De
                           stats_);
   program_ = buildProgram(
       rt, "pathtrace.cl",
-      joinBuildOptions(dev_.scene.buildOptions, pathtraceMajorantBuildOptions(stats_.majorant, options.counters)),
+      dev_.buildOptions(stats_.majorant, options.counters),
       nullptr, &stats_.programFromCache);
-  kernel_ = cl::Kernel(program_, "pathtrace");
+  kernel_ = NamedKernel(program_, "pathtrace");
   statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
   dev_.bind(kernel_);
   allocateAccumulator();
@@ -67,20 +67,19 @@ void PathtraceRenderer::allocateAccumulator() {
   const size_t pixels = size_t(W) * size_t(H), accumBytes = pixels * 4 * sizeof(float);
   const AllocationSite site{view_.sourcePath, "renderer.resolution",
                             "an accumulator of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
-  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
   if (sumBuf_() == nullptr || sumBuf_.getInfo<CL_MEM_SIZE>() != accumBytes) {
     sumBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, accumBytes, site);
     compBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, accumBytes, site);
-    kernel_.setArg(arg + 0, sumBuf_);
-    kernel_.setArg(arg + 1, compBuf_);
-    kernel_.setArg(arg + 4, statusBuf_);
+    kernel_.set("accum_sum", sumBuf_);
+    kernel_.set("accum_comp", compBuf_);
+    kernel_.set("status_word", statusBuf_);
     // -DCOUNTERS: three ulongs per pixel, each work-item adding to its own (pathtrace.cl).
     if (options_.counters) {
       counterBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, pixels * 3 * sizeof(cl_ulong),
                                    {view_.sourcePath, "renderer.resolution",
                                     "collision counters of " + std::to_string(W) + "x" + std::to_string(H) +
                                         " pixels"});
-      kernel_.setArg(arg + 5, counterBuf_);
+      kernel_.set("counter_buf", counterBuf_);
     }
   }
   reset();
@@ -113,10 +112,9 @@ double PathtraceRenderer::addSamples(int count) {
   const size_t pixels = size_t(W) * size_t(H);
   const size_t deviceBytes = deviceSceneBytes(dev_.scene) + 2 * pixels * 4 * sizeof(float) +
                              (options_.counters ? pixels * 3 * sizeof(cl_ulong) : 0);
-  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
-  kernel_.setArg(arg + 2, cl_uint(done_));
-  kernel_.setArg(arg + 3, cl_uint(count));
-  const cl::Event ev = launchAndWait(rt_, kernel_, paddedGlobalRange(W, H, options_), localRange(options_),
+  kernel_.set("sample_begin", cl_uint(done_));
+  kernel_.set("sample_count", cl_uint(count));
+  const cl::Event ev = launchAndWait(rt_, kernel_.get(), paddedGlobalRange(W, H, options_), localRange(options_),
                                      "pathtrace", deviceBytes);
   done_ += count;
   ++stats_.passes;

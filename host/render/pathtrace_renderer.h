@@ -47,7 +47,7 @@ class PathtraceRenderer {
   RenderOptions options_;
   DeviceSceneBuffers dev_;
   cl::Program program_;
-  cl::Kernel kernel_;
+  NamedKernel kernel_;
   cl::Buffer sumBuf_, compBuf_, statusBuf_, counterBuf_;
   int first_ = 0, done_ = 0;
   RenderStats stats_;

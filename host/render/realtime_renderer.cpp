@@ -68,13 +68,13 @@ RealtimeRenderer::RealtimeRenderer(ClRuntime& rt, const Scene& scene, const Dens
                         " samples over the occupied cells of the default " +
                         std::to_string(kDefaultMajorantResolution) + "-cell grid");
   stats_.spp = stats_.sppRequested = 1;
-  program_ = buildProgram(rt, algorithm + ".cl", dev_.scene.buildOptions, nullptr, &stats_.programFromCache);
-  kernel_ = cl::Kernel(program_, algorithm.c_str());
+  program_ = buildProgram(rt, algorithm + ".cl", dev_.buildOptions(), nullptr, &stats_.programFromCache);
+  kernel_ = NamedKernel(program_, algorithm);
   statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
   rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
   noCache_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY, sizeof(float));  // for a cache that is off: never read
   dev_.bind(kernel_);
-  kernel_.setArg(DeviceSceneBuffers::kFirstFreeArg + 5, statusBuf_);
+  kernel_.set("status_word", statusBuf_);
   view_.renderer.width = view_.renderer.height = 0;  // setView uploads everything the first time
   setView(scene);
 }
@@ -90,7 +90,6 @@ const Scene& RealtimeRenderer::checkedScene(const Scene& scene, const RenderOpti
 void RealtimeRenderer::setView(const Scene& view) {
   if (view.renderer.algorithm != view_.renderer.algorithm)
     throw std::invalid_argument("RealtimeRenderer::setView: another algorithm (" + view.renderer.algorithm + ")");
-  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
   const int W = view.renderer.width, H = view.renderer.height;
   const bool resized = W != view_.renderer.width || H != view_.renderer.height;
   const camera_params camera = buildCamera(view);
@@ -101,9 +100,9 @@ void RealtimeRenderer::setView(const Scene& view) {
   const realtime_params params = realtimeParams(view, dev_.scene, rt_.selected.info.maxAllocBytes);
   if (rawBytes(params) != rawBytes(params_) || !paramBuf_()) {
     paramBuf_ = constantBuffer(rt_, params);
-    kernel_.setArg(arg + 0, paramBuf_);
-    if (params.light_cache.nx == 0) kernel_.setArg(arg + 2, noCache_);
-    if (params.ms_cache.nx == 0) kernel_.setArg(arg + 3, noCache_);
+    kernel_.set("params", paramBuf_);
+    if (params.light_cache.nx == 0) kernel_.set("light_cache", noCache_);
+    if (params.ms_cache.nx == 0) kernel_.set("ms_cache", noCache_);
   }
   // The lobe's directions depend on its point count (and g, seed: the scene's); one dummy otherwise.
   if (params.lobe_points != params_.lobe_points || !dirBuf_()) {
@@ -115,14 +114,14 @@ void RealtimeRenderer::setView(const Scene& view) {
     dirCount_ = dirs.size();
     dirBuf_ = cl::Buffer(rt_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4),
                          dirs.data());
-    kernel_.setArg(arg + 1, dirBuf_);
+    kernel_.set("lobe_directions", dirBuf_);
   }
   params_ = params;
   if (resized) {
     const AllocationSite site{view.sourcePath, "renderer.resolution",
                               "an image of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
     outBuf_ = allocateBuffer(rt_, CL_MEM_WRITE_ONLY, size_t(W) * size_t(H) * 4 * sizeof(float), site);
-    kernel_.setArg(arg + 4, outBuf_);
+    kernel_.set("out", outBuf_);
   }
   view_ = view;
   stats_.width = W;
@@ -130,22 +129,21 @@ void RealtimeRenderer::setView(const Scene& view) {
 }
 
 double RealtimeRenderer::renderFrame(bool progressiveCache, double* wallMs) {
-  const cl_uint arg = DeviceSceneBuffers::kFirstFreeArg;
   if (params_.light_cache.nx > 0) {  // a no-op unless the medium or a light changed
     lightCache_.update(rt_, dev_, params_, view_.sourcePath);
-    kernel_.setArg(arg + 2, lightCache_.buffer());
+    kernel_.set("light_cache", lightCache_.buffer());
   }
   if (params_.ms_cache.nx > 0) {  // built to its paths (progressively: one launch a frame), then kept
     const MsCacheSettings& mc = view_.renderer.raymarch.msCache;
     const int target = progressiveCache ? std::min(mc.paths, msCache_.paths() + mc.pathsPerLaunch) : mc.paths;
     msCache_.refine(rt_, dev_, params_, target, mc.pathsPerLaunch, view_.sourcePath);
-    kernel_.setArg(arg + 3, msCache_.buffer());
+    kernel_.set("ms_cache", msCache_.buffer());
   }
   const int W = view_.renderer.width, H = view_.renderer.height;
   const size_t deviceBytes = deviceSceneBytes(dev_.scene) + size_t(W) * size_t(H) * 4 * sizeof(float) +
                              sizeof(params_) + dirCount_ * sizeof(nv_float4) + lightCache_.bytes() + msCache_.bytes();
   const auto t0 = std::chrono::steady_clock::now();
-  const cl::Event ev = launchAndWait(rt_, kernel_, paddedGlobalRange(W, H, options_), localRange(options_),
+  const cl::Event ev = launchAndWait(rt_, kernel_.get(), paddedGlobalRange(W, H, options_), localRange(options_),
                                      view_.renderer.algorithm, deviceBytes);
   if (wallMs) *wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ++stats_.passes;

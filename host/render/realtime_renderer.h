@@ -62,7 +62,7 @@ class RealtimeRenderer {
   DeviceLightCache lightCache_;
   DeviceMsCache msCache_;
   cl::Program program_;
-  cl::Kernel kernel_;
+  NamedKernel kernel_;
   cl::Buffer paramBuf_, dirBuf_, outBuf_, statusBuf_, noCache_;
   size_t dirCount_ = 0;
   RenderStats stats_;

@@ -218,11 +218,7 @@ DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
   }
   sp.num_lights = int(ds.lights.size());
   if (ds.lights.empty()) ds.lights.push_back(light_params{});  // a buffer may not be empty
-  ds.buildOptions = (!sp.has_medium || !grid) ? "-DMEDIUM_HOMOGENEOUS" : "";
-  if (kernelSpecialisationEnabled()) {  // render/kernel_features.h
-    const std::string features = sceneFeatureOptions(ds);
-    if (!features.empty()) ds.buildOptions += (ds.buildOptions.empty() ? "" : " ") + features;
-  }
+  ds.buildOptions = sceneBuildOptions(ds);  // render/kernel_features.h
   return ds;
 }
 

@@ -164,8 +164,8 @@ static inline float grid_bricks_trilinear(NV_GLOBAL const uint* table, NV_GLOBAL
 #ifdef NV_DEVICE
 
 #ifdef MEDIUM_HOMOGENEOUS
-#define GRID_PARAM int grid_unused, NV_GLOBAL const float* grid_majorants
-#define GRID_ARG grid_unused, grid_majorants
+#define GRID_PARAM int grid, NV_GLOBAL const float* grid_majorants /* grid: unused, an int */
+#define GRID_ARG grid, grid_majorants
 #define GRID_KERNEL_PARAM GRID_PARAM
 #define GRID_MAJORANTS grid_majorants
 #define GRID_IS_HOMOGENEOUS(g) 1

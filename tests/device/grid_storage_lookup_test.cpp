@@ -36,6 +36,7 @@
 
 #include "cl/cl_runtime.h"
 #include "render/device_grid.h"
+#include "render/kernel_features.h"
 #include "shared/grid.h"
 #include "shared/structs.h"
 #include "volume/brick_grid.h"

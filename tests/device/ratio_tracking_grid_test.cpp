@@ -19,6 +19,7 @@
 
 #include "cl/cl_runtime.h"
 #include "render/device_grid.h"
+#include "render/kernel_features.h"
 #include "render/scene_upload.h"
 #include "scene/scene.h"
 #include "shared/grid.h"

@@ -14,6 +14,7 @@
 
 #include "render/device_allocation.h"
 #include "render/device_grid.h"
+#include "render/kernel_features.h"
 #include "render/device_scene.h"
 #include "render/render_common.h"
 #include "render_fixture.h"
@@ -216,7 +217,7 @@ TEST(BrickStorage, DeviceBytesCountTheBricks) {
   EXPECT_EQ(dev.bricks, 64u);
   EXPECT_EQ(dev.bricksOccupied, 1u);
   EXPECT_EQ(dev.scene.gridBytes, planBricks(g).bufferBytes());
-  EXPECT_NE(dev.scene.buildOptions.find("-DGRID_STORAGE_BRICKS"), std::string::npos);
+  EXPECT_NE(dev.buildOptions().find("-DGRID_STORAGE_BRICKS"), std::string::npos);
   EXPECT_LT(deviceSceneBytes(dev.scene), g.voxelCount() * sizeof(float));
 }
 

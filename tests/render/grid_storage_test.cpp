@@ -31,6 +31,7 @@
 #include <string>
 
 #include "render/device_grid.h"
+#include "render/kernel_features.h"
 #include "render/device_scene.h"
 #include "render_fixture.h"
 #include "test_support.h"
@@ -171,11 +172,11 @@ TEST(GridStorage, TheResolvedChoiceIsRecordedAndBuilt) {
     withStorage.renderer.storage = s;
     const DeviceSceneBuffers onGrid(runtime(), withStorage, &cloud);
     EXPECT_EQ(onGrid.storage, s);
-    const bool bufferOption = onGrid.scene.buildOptions.find("-DGRID_STORAGE_BUFFER") != std::string::npos;
-    EXPECT_EQ(bufferOption, s == GridStorage::Buffer) << onGrid.scene.buildOptions;
+    const bool bufferOption = onGrid.buildOptions().find("-DGRID_STORAGE_BUFFER") != std::string::npos;
+    EXPECT_EQ(bufferOption, s == GridStorage::Buffer) << onGrid.buildOptions();
     const DeviceSceneBuffers homogeneous(runtime(), withStorage, nullptr);
-    EXPECT_NE(homogeneous.scene.buildOptions.find("-DMEDIUM_HOMOGENEOUS"), std::string::npos);
-    EXPECT_EQ(homogeneous.scene.buildOptions.find("-DGRID_STORAGE_BUFFER"), std::string::npos)
+    EXPECT_NE(homogeneous.buildOptions().find("-DMEDIUM_HOMOGENEOUS"), std::string::npos);
+    EXPECT_EQ(homogeneous.buildOptions().find("-DGRID_STORAGE_BUFFER"), std::string::npos)
         << "one program for every storage when there is no grid";
   }
 }
