@@ -1,6 +1,7 @@
 /* light_cache.cl: builds one light's slab of the light-transmittance cache (shared/light_cache.h).
  * One work-item per node (1D, padded to a multiple of the local size; items past the slab return).
  * `light` selects the light and its slab, so a light that changed is rebuilt alone. */
+#include "shared/scene_kinds.h"
 #include "shared/light_cache.h"
 
 __kernel void light_cache_build(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
@@ -10,7 +11,7 @@ __kernel void light_cache_build(__constant scene_params* scene, __constant light
   __constant node_grid_params* c = &params->light_cache;
   const int nodes = node_grid_count(c);
   if (node >= nodes) return;
-  uint status = 0u;
+  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
   cache[(size_t)light * (size_t)nodes + (size_t)node] =
       light_cache_build_node(&scene->medium, GRID_ARG, c, params->shadow_steps, params->shadow_area_samples,
                              &lights[light], node, &status);

@@ -3,6 +3,7 @@
  * multiple of the local size, so work-items past the image return at once. light_cache holds the
  * light-transmittance cache (a one-float placeholder when it is off); ms_cache, part of the
  * signature the real-time kernels share, is the ray marcher's and not read here. */
+#include "shared/scene_kinds.h"
 #include "shared/lobe.h"
 
 __kernel void lobe(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
@@ -11,7 +12,7 @@ __kernel void lobe(__constant scene_params* scene, __constant light_params* ligh
                    __global uint* status_word) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
-  uint status = 0u;
+  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
   /* float4 and nv_float4 hold the same four floats (structs.h). */
   const vec3 L = lobe_pixel(scene, lights, GRID_ARG, params, (__global const nv_float4*)lobe_directions, light_cache,
                             x, y, &status);

@@ -1,6 +1,7 @@
 /* ms_cache.cl: adds `count` paths per node to the multiple-scattering cache (shared/ms_cache_build.h),
  * paths [first, first + count) of each node. One work-item per node (1D, padded to a multiple of
  * the local size). `scene` is the scene with one bounce fewer (ms_cache.h, "Bounces"). */
+#include "shared/scene_kinds.h"
 #include "shared/ms_cache_build.h"
 
 __kernel void ms_cache_build(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
@@ -9,7 +10,7 @@ __kernel void ms_cache_build(__constant scene_params* scene, __constant light_pa
   const int node = get_global_id(0);
   __constant node_grid_params* c = &params->ms_cache;
   if (node >= node_grid_count(c)) return;
-  uint status = 0u;
+  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
   ms_cache_refine_node(scene, lights, GRID_ARG, c, node, cache + (size_t)node * MS_CACHE_STRIDE, first, count,
                        &status);
   if (status) atomic_or(status_word, status);

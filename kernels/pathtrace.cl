@@ -3,6 +3,7 @@
  * many short launches (progress, no GPU watchdog) and any split gives the same per-sample values.
  * -DCOUNTERS adds a last argument: 3 ulongs per pixel (tentative collisions, real collisions,
  * density lookups; tracking.h) to which each work-item adds its own pass's counts, no atomics. */
+#include "shared/scene_kinds.h"
 #include "shared/accum.h"
 #include "shared/pathtrace.h"
 
@@ -15,7 +16,7 @@ __kernel void pathtrace(__constant scene_params* scene, __constant light_params*
                         ) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
-  uint status = 0u;
+  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
 #ifdef COUNTERS
   track_counters counts = {0, 0, 0};
   track_counters* counters = &counts;

@@ -3,6 +3,7 @@
  * lobe_directions is part of the signature the real-time kernels share and is not read here;
  * light_cache and ms_cache hold the light-transmittance and multiple-scattering caches (a one-float
  * placeholder when off). */
+#include "shared/scene_kinds.h"
 #include "shared/raymarch.h"
 
 __kernel void raymarch(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
@@ -11,7 +12,7 @@ __kernel void raymarch(__constant scene_params* scene, __constant light_params* 
                        __global uint* status_word) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
-  uint status = 0u;
+  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
   const vec3 L = raymarch_pixel(scene, lights, GRID_ARG, params, light_cache, ms_cache, x, y, &status);
   out[y * scene->camera.width + x] = (float4)(L.x, L.y, L.z, 0.0f);
   if (status) atomic_or(status_word, status);

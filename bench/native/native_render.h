@@ -109,11 +109,7 @@ inline grid_view nativeGridView(const DeviceScene& ds, const NativeOptions& o) {
 inline void prepareRealtimeInputs(const Scene& scene, const DeviceScene& ds, NativeOptions& o) {
   if (o.algorithm == "pathtrace") return;
   o.realtime = realtimeParams(scene, ds);
-  if (o.algorithm == "lobe") {
-    const scene_params& sp = ds.params;
-    const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
-    o.lobeDirections = lobeDirections(o.realtime.lobe_points, g, scene.renderer.seed);
-  }
+  if (o.algorithm == "lobe") o.lobeDirections = lobeDirections(o.realtime.lobe_points, ds.params, scene.renderer.seed);
   if (o.realtime.ms_cache.nx > 0)
     throw std::invalid_argument("narval-native: the multiple-scattering cache is built on OpenCL devices only");
   if (o.realtime.light_cache.nx > 0) {

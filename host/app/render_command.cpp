@@ -82,7 +82,8 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"status",
            {{"nan", (s.status & STATUS_NAN) != 0},
             {"negative_pdf", (s.status & STATUS_NEGATIVE_PDF) != 0},
-            {"iteration_cap", (s.status & STATUS_ITERATION_CAP) != 0}}},
+            {"iteration_cap", (s.status & STATUS_ITERATION_CAP) != 0},
+            {"unknown_kind", (s.status & STATUS_UNKNOWN_KIND) != 0}}},
           {"scene", scene.sourcePath}};
 }
 

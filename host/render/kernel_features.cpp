@@ -14,6 +14,11 @@ std::string joinBuildOptions(const std::string& base, const std::string& extra) 
   return base + " " + extra;
 }
 
+// A kind the kernels do not know (structs.h): the host's own error, never the user's input.
+std::logic_error unknownKind(const std::string& what, int kind) {
+  return std::logic_error("the kernels know no " + what + " kind " + std::to_string(kind));
+}
+
 }  // namespace
 
 std::string sceneFeatureOptions(const DeviceScene& ds) {
@@ -24,12 +29,20 @@ std::string sceneFeatureOptions(const DeviceScene& ds) {
     o += d;
   };
   if (sp.has_medium) {
-    add(sp.medium.phase == PHASE_HG ? "-DPHASE_FIXED_HG" : "-DPHASE_FIXED_ISOTROPIC");
+    switch (sp.medium.phase) {
+      case PHASE_HG: add("-DPHASE_FIXED_HG"); break;
+      case PHASE_ISOTROPIC: add("-DPHASE_FIXED_ISOTROPIC"); break;
+      default: throw unknownKind("phase function", sp.medium.phase);
+    }
     add(sp.medium.grey ? "-DMEDIUM_GREY" : "-DMEDIUM_CHROMATIC");
   }
   int rects = 0, points = 0;
   for (int i = 0; i < sp.num_lights && size_t(i) < ds.lights.size(); ++i)
-    (ds.lights[size_t(i)].type == LIGHT_RECTANGLE ? rects : points) += 1;
+    switch (ds.lights[size_t(i)].type) {
+      case LIGHT_RECTANGLE: ++rects; break;
+      case LIGHT_POINT: ++points; break;
+      default: throw unknownKind("light", ds.lights[size_t(i)].type);
+    }
   if (rects == 0)
     add("-DLIGHTS_POINT_ONLY");  // also with no light at all: nothing to intersect
   else if (points == 0)
@@ -41,7 +54,9 @@ std::string sceneFeatureOptions(const DeviceScene& ds) {
 std::string sceneBuildOptions(const DeviceScene& ds) {
   const scene_params& sp = ds.params;
   std::string o = (!sp.has_medium || !ds.grid) ? "-DMEDIUM_HOMOGENEOUS" : "";
-  if (kernelSpecialisationEnabled()) o = joinBuildOptions(o, sceneFeatureOptions(ds));
+  // Derived either way, so an unknown kind is an error on the host before anything is built.
+  const std::string features = sceneFeatureOptions(ds);
+  if (kernelSpecialisationEnabled()) o = joinBuildOptions(o, features);
   return o;
 }
 

@@ -20,4 +20,8 @@ std::vector<nv_float4> lobeDirections(int n, float g, uint32_t seed) {
   return dirs;
 }
 
+std::vector<nv_float4> lobeDirections(int n, const scene_params& sp, uint32_t seed) {
+  return lobeDirections(n, sp.has_medium ? phase_mean_cosine(sp.medium.phase, sp.medium.g) : 0.0f, seed);
+}
+
 }  // namespace narval

@@ -15,4 +15,8 @@ namespace narval {
 // counter-based RNG keyed by `seed`: the same set for the same (n, g, seed) on every machine.
 std::vector<nv_float4> lobeDirections(int n, float g, uint32_t seed);
 
+// The directions for the medium of `sp` (scene as uploaded): its phase function's mean cosine
+// (phase_mean_cosine: g for HG, 0 isotropic), or isotropic without a medium.
+std::vector<nv_float4> lobeDirections(int n, const scene_params& sp, uint32_t seed);
+
 }  // namespace narval

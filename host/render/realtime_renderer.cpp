@@ -106,10 +106,8 @@ void RealtimeRenderer::setView(const Scene& view) {
   }
   // The lobe's directions depend on its point count (and g, seed: the scene's); one dummy otherwise.
   if (params.lobe_points != params_.lobe_points || !dirBuf_()) {
-    const scene_params& sp = dev_.scene.params;
-    const float g = sp.has_medium && sp.medium.phase == PHASE_HG ? sp.medium.g : 0.0f;
     std::vector<nv_float4> dirs = view.renderer.algorithm == "lobe"
-                                      ? lobeDirections(params.lobe_points, g, view.renderer.seed)
+                                      ? lobeDirections(params.lobe_points, dev_.scene.params, view.renderer.seed)
                                       : std::vector<nv_float4>(1, nv_float4{0, 0, 1, 0});
     dirCount_ = dirs.size();
     dirBuf_ = cl::Buffer(rt_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4),

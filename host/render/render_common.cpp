@@ -108,6 +108,8 @@ std::vector<std::string> statusWarnings(uint32_t status) {
   if (status & STATUS_NAN) w.push_back("the kernel produced non-finite samples (dropped)");
   if (status & STATUS_NEGATIVE_PDF) w.push_back("the kernel met a non-positive pdf");
   if (status & STATUS_ITERATION_CAP) w.push_back("a loop hit its iteration cap (tracking walk or majorant DDA)");
+  if (status & STATUS_UNKNOWN_KIND)
+    w.push_back("a phase function or light kind the kernels do not know reached them (it sent no light)");
   return w;
 }
 

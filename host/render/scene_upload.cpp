@@ -61,10 +61,13 @@ nv_affine rotationOnly(const Transform& t) {
 light_params buildLight(const Primitive& p, const Material& m) {
   light_params l{};
   l.radiance = f4(m.albedo);
-  if (p.type == PrimitiveType::Point) {
-    l.type = LIGHT_POINT;
-    l.corner = f4(p.transform.position);
-    return l;
+  switch (p.type) {
+    case PrimitiveType::Point:
+      l.type = LIGHT_POINT;
+      l.corner = f4(p.transform.position);
+      return l;
+    case PrimitiveType::Rectangle: break;  // below
+    case PrimitiveType::Volume: throw std::logic_error("buildLight: a volume is not a light");
   }
   // The unit quad [-0.5, 0.5]² in local XY, emitting along local -Z (DESIGN.md, emitters). The
   // emission direction follows the rotation alone: scale changes the extent, not the facing.
@@ -167,8 +170,16 @@ DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
     const float D = m.density;
     med.sigma_a = f4(m.absorption[0] * D, m.absorption[1] * D, m.absorption[2] * D);
     med.sigma_s = f4(m.scattering[0] * D, m.scattering[1] * D, m.scattering[2] * D);
-    med.phase = m.phase == PhaseFunction::HenyeyGreenstein ? PHASE_HG : PHASE_ISOTROPIC;
-    med.g = med.phase == PHASE_HG ? m.g : 0.0f;
+    switch (m.phase) {
+      case PhaseFunction::HenyeyGreenstein:
+        med.phase = PHASE_HG;
+        med.g = m.g;
+        break;
+      case PhaseFunction::Isotropic:
+        med.phase = PHASE_ISOTROPIC;
+        med.g = 0.0f;
+        break;
+    }
     med.grey = m.absorption[0] == m.absorption[1] && m.absorption[1] == m.absorption[2] &&
                m.scattering[0] == m.scattering[1] && m.scattering[1] == m.scattering[2];
     float maxSigmaT = 0.0f;

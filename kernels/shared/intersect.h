@@ -4,17 +4,21 @@
 
 #include "shared/structs.h"
 
-/* Light kinds (scene specialisation, host/render/kernel_features.h): -DLIGHTS_POINT_ONLY when the
- * scene has no rectangle light (point lights or none), -DLIGHTS_RECT_ONLY when all its lights are
- * rectangles; the type tests fold and, with points only, intersect_lights returns "no hit" without
- * looping. Same arithmetic as the generic kernel. Neither: the runtime light_params.type. */
+/* Light kinds (LIGHT_RECTANGLE, LIGHT_POINT), dispatched by switch on LIGHT_KIND; an unknown kind
+ * sends no light and is reported at the kernel's entry (scene_kinds.h). Scene specialisation
+ * (host/render/kernel_features.h): -DLIGHTS_POINT_ONLY when the scene has no rectangle light (point
+ * lights or none), -DLIGHTS_RECT_ONLY when all its lights are rectangles; the switches fold and,
+ * with points only, intersect_lights returns "no hit" without looping. Same arithmetic as the
+ * generic kernel. Neither: the runtime light_params.type. */
 #if defined(LIGHTS_POINT_ONLY)
-#define LIGHT_IS_RECT(l) 0
+#define LIGHT_KIND(l) LIGHT_POINT
 #elif defined(LIGHTS_RECT_ONLY)
-#define LIGHT_IS_RECT(l) 1
+#define LIGHT_KIND(l) LIGHT_RECTANGLE
 #else
-#define LIGHT_IS_RECT(l) ((l)->type == LIGHT_RECTANGLE)
+#define LIGHT_KIND(l) ((l)->type)
 #endif
+/* Only rectangles can be hit by a ray (a point light has no area). */
+#define LIGHT_IS_RECT(l) (LIGHT_KIND(l) == LIGHT_RECTANGLE)
 
 /* Slab test of o + t·d against the box [0, hi]. Returns 1 and the parametric interval when the ray
  * line meets the box. A zero direction component gives ±inf slab bounds (IEEE); fmin/fmax discard

@@ -12,28 +12,42 @@ typedef struct light_sample {
   float pdf;      /* solid-angle pdf; 0 for a point light (a delta: no MIS) */
 } light_sample;
 
-/* Samples light `l` as seen from x; returns 0 when it cannot contribute (back side, degenerate). */
-static inline int light_sample_point(NV_CONSTANT const light_params* l, vec3 x, float u1, float u2,
-                                     NV_PRIVATE light_sample* s) {
-  vec3 y = vec3_from4(l->corner);
-  if (LIGHT_IS_RECT(l))
-    y = vec3_add(y, vec3_add(vec3_scale(vec3_from4(l->edge_u), u1), vec3_scale(vec3_from4(l->edge_v), u2)));
+/* Aims s at y from x (unit direction, distance); returns d², or 0 when y is x (or NaN). */
+static inline float light_aim(vec3 y, vec3 x, NV_PRIVATE light_sample* s) {
   const vec3 to = vec3_sub(y, x);
   const float d2 = vec3_dot(to, to);
-  if (!(d2 > 0.0f)) return 0;
+  if (!(d2 > 0.0f)) return 0.0f;
   s->dist = nv_sqrt(d2);
   s->dir = vec3_scale(to, 1.0f / s->dist);
-  if (!LIGHT_IS_RECT(l)) {
-    s->radiance = vec3_scale(vec3_from4(l->radiance), 1.0f / d2);
-    s->pdf = 0.0f;
-    return 1;
+  return d2;
+}
+
+/* Samples light `l` as seen from x; returns 0 when it cannot contribute (back side, degenerate, an
+ * unknown kind). */
+static inline int light_sample_point(NV_CONSTANT const light_params* l, vec3 x, float u1, float u2,
+                                     NV_PRIVATE light_sample* s) {
+  switch (LIGHT_KIND(l)) {
+    case LIGHT_POINT: {
+      const float d2 = light_aim(vec3_from4(l->corner), x, s);
+      if (!(d2 > 0.0f)) return 0;
+      s->radiance = vec3_scale(vec3_from4(l->radiance), 1.0f / d2);
+      s->pdf = 0.0f;
+      return 1;
+    }
+    case LIGHT_RECTANGLE: {
+      const vec3 y = vec3_add(vec3_from4(l->corner), vec3_add(vec3_scale(vec3_from4(l->edge_u), u1),
+                                                               vec3_scale(vec3_from4(l->edge_v), u2)));
+      const float d2 = light_aim(y, x, s);
+      if (!(d2 > 0.0f)) return 0;
+      /* Uniform on the area A, converted to solid angle: pdf = d² / (cos θ_l · A). */
+      const float cos_l = -vec3_dot(s->dir, vec3_from4(l->normal));
+      if (!(cos_l > 0.0f)) return 0;
+      s->radiance = vec3_from4(l->radiance);
+      s->pdf = d2 / (cos_l * l->normal.w);
+      return 1;
+    }
+    default: return 0; /* unknown: reported at the kernel's entry */
   }
-  /* Uniform on the area A, converted to solid angle: pdf = d² / (cos θ_l · A). */
-  const float cos_l = -vec3_dot(s->dir, vec3_from4(l->normal));
-  if (!(cos_l > 0.0f)) return 0;
-  s->radiance = vec3_from4(l->radiance);
-  s->pdf = d2 / (cos_l * l->normal.w);
-  return 1;
 }
 
 /* Solid-angle pdf with which light_sample_point would pick the point hit at distance t along the

@@ -145,11 +145,15 @@ static inline float march_column_density(NV_CONSTANT const medium_params* m, GRI
   return column * it.delta;
 }
 
-/* Where the real-time kernels put a light: a point light's position, a rectangle's centre. */
+/* Where the real-time kernels put a light: a point light's position, a rectangle's centre (an
+ * unknown kind: its corner; it sends nothing, march_light_as_point). */
 static inline vec3 march_light_position(NV_CONSTANT const light_params* l) {
   const vec3 p = vec3_from4(l->corner);
-  if (LIGHT_IS_RECT(l)) return vec3_add(p, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
-  return p;
+  switch (LIGHT_KIND(l)) {
+    case LIGHT_RECTANGLE: return vec3_add(p, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
+    case LIGHT_POINT: return p;
+    default: return p;
+  }
 }
 
 /* A light as seen from x, as a point: unit direction to it, distance, and the intensity I (W/sr)
@@ -162,10 +166,15 @@ static inline int march_light_as_point(NV_CONSTANT const light_params* l, vec3 x
   if (!(d2 > 0.0f)) return 0;
   *dist = nv_sqrt(d2);
   *dir = vec3_scale(to, 1.0f / *dist);
-  if (LIGHT_IS_RECT(l)) {
-    const float cos_l = -vec3_dot(*dir, vec3_from4(l->normal));
-    if (!(cos_l > 0.0f)) return 0;
-    I = vec3_scale(I, l->normal.w * cos_l);
+  switch (LIGHT_KIND(l)) {
+    case LIGHT_RECTANGLE: {
+      const float cos_l = -vec3_dot(*dir, vec3_from4(l->normal));
+      if (!(cos_l > 0.0f)) return 0;
+      I = vec3_scale(I, l->normal.w * cos_l);
+      break;
+    }
+    case LIGHT_POINT: break;
+    default: return 0; /* unknown: reported at the kernel's entry */
   }
   *intensity = I;
   return 1;
@@ -191,11 +200,15 @@ static inline vec3 march_light_area_point(NV_CONSTANT const light_params* l, int
 static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3 x, int phase_kind, float g,
                                          vec3 view_dir, int K) {
   const vec3 Le = vec3_from4(l->radiance);
-  if (!LIGHT_IS_RECT(l)) {
-    const vec3 to = vec3_sub(vec3_from4(l->corner), x);
-    const float d2 = vec3_dot(to, to);
-    if (!(d2 > 0.0f)) return vec3_splat(0.0f);
-    return vec3_scale(Le, phase_eval(phase_kind, g, view_dir, vec3_scale(to, 1.0f / nv_sqrt(d2))) / d2);
+  switch (LIGHT_KIND(l)) {
+    case LIGHT_POINT: {
+      const vec3 to = vec3_sub(vec3_from4(l->corner), x);
+      const float d2 = vec3_dot(to, to);
+      if (!(d2 > 0.0f)) return vec3_splat(0.0f);
+      return vec3_scale(Le, phase_eval(phase_kind, g, view_dir, vec3_scale(to, 1.0f / nv_sqrt(d2))) / d2);
+    }
+    case LIGHT_RECTANGLE: break; /* below */
+    default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
   }
   const vec3 n = vec3_from4(l->normal);
   const float inv_k = 1.0f / (float)K;
@@ -224,7 +237,12 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
  * for a coloured one it is the average for the mean σt. */
 static inline float march_light_column(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_CONSTANT const light_params* l,
                                        vec3 x, int K, int shadow_steps, NV_PRIVATE uint* status) {
-  const int area = LIGHT_IS_RECT(l) && K > 1;
+  int area = 0; /* a rectangle's K×K points, else the light's one point */
+  switch (LIGHT_KIND(l)) {
+    case LIGHT_RECTANGLE: area = K > 1; break;
+    case LIGHT_POINT: break;
+    default: return 0.0f; /* unknown: sends nothing (march_light_as_point), reported at the entry */
+  }
   const vec3 n = vec3_from4(l->normal);
   const int k_side = area ? K : 1;
   const float sigma = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));

@@ -7,6 +7,7 @@
 #define NARVAL_PHASE_H
 
 #include "shared/sampling.h"
+#include "shared/structs.h" /* PHASE_* kinds */
 
 /* Below this |g| HG is evaluated and sampled as isotropic: the inverse-CDF formula divides by g,
  * and |p_HG − 1/(4π)| <= 3|g|/(4π)·(1+O(g)) is then under 1e-3 relative. */
@@ -35,31 +36,57 @@ static inline float phase_hg_sample_cos(float g, float u) {
   return nv_fmin(1.0f, nv_fmax(-1.0f, mu));
 }
 
-/* Scene specialisation (DESIGN.md "model only what a scene needs"; host/render/kernel_features.h):
- * -DPHASE_FIXED_ISOTROPIC or -DPHASE_FIXED_HG fixes the phase function at build time, so the
- * compiler folds the test on `kind` (the host sets one only when the scene's medium has that phase
- * function: the arithmetic is the generic kernel's, bit for bit). Neither: the runtime `kind`. */
+/* Kinds (PHASE_ISOTROPIC, PHASE_HG from structs.h) are dispatched by switch. An unknown kind gives
+ * no scattering here; every kernel's entry reports it (scene_kinds.h, STATUS_UNKNOWN_KIND) and the
+ * host never uploads one (render/kernel_features.h checks).
+ * Scene specialisation (DESIGN.md "model only what a scene needs"; host/render/kernel_features.h):
+ * -DPHASE_FIXED_ISOTROPIC or -DPHASE_FIXED_HG fixes the kind at build time, so the compiler folds
+ * the switch (the host sets one only when the scene's medium has that phase function: the
+ * arithmetic is the generic kernel's, bit for bit). Neither: the runtime `kind`. */
 #if defined(PHASE_FIXED_ISOTROPIC)
-#define PHASE_IS_HG(kind) 0
+#define PHASE_KIND(kind) PHASE_ISOTROPIC
 #elif defined(PHASE_FIXED_HG)
-#define PHASE_IS_HG(kind) 1
+#define PHASE_KIND(kind) PHASE_HG
 #else
-#define PHASE_IS_HG(kind) ((kind) == 1)
+#define PHASE_KIND(kind) (kind)
 #endif
 
-/* Phase function selected by `kind` (PHASE_ISOTROPIC or PHASE_HG from structs.h). */
 static inline float phase_eval(int kind, float g, vec3 w_in, vec3 w_out) {
-  return PHASE_IS_HG(kind) ? phase_hg_eval(g, vec3_dot(w_in, w_out)) : NV_INV_4PI;
+  switch (PHASE_KIND(kind)) {
+    case PHASE_ISOTROPIC: return NV_INV_4PI;
+    case PHASE_HG: return phase_hg_eval(g, vec3_dot(w_in, w_out));
+    default: return 0.0f; /* unknown: reported at the kernel's entry */
+  }
 }
 
-/* Samples w_out given the propagation direction w_in; returns it and writes its pdf. */
+/* Samples w_out given the propagation direction w_in; returns it and writes its pdf (0 for an
+ * unknown kind: the path goes on unscattered and no MIS weight uses it). */
 static inline vec3 phase_sample(int kind, float g, vec3 w_in, float u1, float u2, NV_PRIVATE float* pdf) {
-  const float mu = PHASE_IS_HG(kind) ? phase_hg_sample_cos(g, u1) : 1.0f - 2.0f * u1;
-  const vec3 w_out = sample_direction_around(w_in, mu, u2);
-  /* The pdf of the direction actually returned: for |g| near 1 the HG peak is a few float steps
-   * of μ wide, and MIS needs the same value phase_pdf gives for this direction. */
-  *pdf = PHASE_IS_HG(kind) ? phase_hg_eval(g, vec3_dot(w_in, w_out)) : NV_INV_4PI;
-  return w_out;
+  switch (PHASE_KIND(kind)) {
+    case PHASE_ISOTROPIC: {
+      const vec3 w_out = sample_direction_around(w_in, 1.0f - 2.0f * u1, u2);
+      *pdf = NV_INV_4PI;
+      return w_out;
+    }
+    case PHASE_HG: {
+      const vec3 w_out = sample_direction_around(w_in, phase_hg_sample_cos(g, u1), u2);
+      /* The pdf of the direction actually returned: for |g| near 1 the HG peak is a few float steps
+       * of μ wide, and MIS needs the same value phase_pdf gives for this direction. */
+      *pdf = phase_hg_eval(g, vec3_dot(w_in, w_out));
+      return w_out;
+    }
+    default: *pdf = 0.0f; return w_in;
+  }
+}
+
+/* The phase function's mean cosine (its first zonal coefficient): g for HG, 0 for isotropic (and an
+ * unknown kind). */
+static inline float phase_mean_cosine(int kind, float g) {
+  switch (PHASE_KIND(kind)) {
+    case PHASE_HG: return g;
+    case PHASE_ISOTROPIC: return 0.0f;
+    default: return 0.0f;
+  }
 }
 
 static inline float phase_pdf(int kind, float g, vec3 w_in, vec3 w_out) {

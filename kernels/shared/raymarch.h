@@ -169,7 +169,7 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
       vec3 Li = raymarch_light_sum(s, lights, GRID_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir, status);
       if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h) */
         Li = vec3_add(Li, ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), vec3_madd(seg->o, seg->d, t),
-                                          m->phase == PHASE_HG ? m->g : 0.0f, vec3_scale(dir, -1.0f)));
+                                          phase_mean_cosine(m->phase, m->g), vec3_scale(dir, -1.0f)));
       S = vec3_mul(sigma_s, Li);
     }
     const vec3 x = vec3_scale(sigma_t, dt);

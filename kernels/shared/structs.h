@@ -18,6 +18,9 @@
 #define STATUS_NAN 1u
 #define STATUS_NEGATIVE_PDF 2u
 #define STATUS_ITERATION_CAP 4u
+/* A phase function or light kind the kernels do not know reached them (scene_kinds.h): the host
+ * validates kinds before uploading, so this means a host and kernels out of step. */
+#define STATUS_UNKNOWN_KIND 8u
 
 /* Pinhole or thin-lens camera. Pixel (0,0) is the top-left corner of the image. */
 typedef struct camera_params {

@@ -7,6 +7,9 @@
 //   by the loader from the data it checked finite, so no majorant falls below σt. It is proven live
 //   through the library (tests/render/status_word_test.cpp, a Scene/DenseGrid edited after
 //   loading) and on the host (tests/unit/status_word_host_test.cpp).
+// - STATUS_UNKNOWN_KIND (status.unknown_kind) cannot either: the host refuses a phase function or
+//   light kind the kernels do not know before it builds anything (tests/render/kernel_features_test.cpp);
+//   a kernel raises it in tests/device/shared_functions_test.cpp.
 #include <gtest/gtest.h>
 
 #include <string>

@@ -5,9 +5,11 @@
  * data), which is what the tracking kernels compare against. */
 #include "shared/camera.h"
 #include "shared/intersect.h"
+#include "shared/light.h"
 #include "shared/phase.h"
 #include "shared/rng.h"
 #include "shared/sampling.h"
+#include "shared/scene_kinds.h"
 #include "shared/tracking.h"
 
 /* in: g[i], mu[i] -> phase_hg_eval */
@@ -117,4 +119,19 @@ __kernel void sf_tracking_delta(__constant medium_params* m, __global const floa
   out[5 * i + 2] = beta.x;
   out[5 * i + 3] = beta.y;
   out[5 * i + 4] = beta.z;
+}
+
+/* Kinds the kernels dispatch on, one item: out[0] the entry's status (scene_kinds_status), out[1]
+ * the bits of phase_eval for the scene's phase kind, out[2] the bits of phase_sample's pdf, out[3]
+ * light_sample_point's answer for lights[0] seen from the origin. */
+__kernel void sf_scene_kinds(__constant scene_params* s, __constant light_params* lights, __global uint* out, uint n) {
+  if (get_global_id(0) != 0 || n < 1u) return;
+  const vec3 w = vec3_make(0.0f, 0.0f, 1.0f);
+  float pdf = -1.0f;
+  phase_sample(s->medium.phase, s->medium.g, w, 0.25f, 0.5f, &pdf);
+  light_sample ls;
+  out[0] = scene_kinds_status(s, lights);
+  out[1] = as_uint(phase_eval(s->medium.phase, s->medium.g, w, w));
+  out[2] = as_uint(pdf);
+  out[3] = (uint)light_sample_point(&lights[0], vec3_make(0.0f, 0.0f, 0.0f), 0.5f, 0.5f, &ls);
 }

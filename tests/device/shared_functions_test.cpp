@@ -433,4 +433,58 @@ TEST_F(SharedOnDevice, TrackingDeltaChromaticHomogeneous) {
   beta.report();
 }
 
+// Kinds: every kernel's entry flags a phase function or light kind it does not know
+// (STATUS_UNKNOWN_KIND), and the switches give such a kind nothing: phase_eval 0, phase_sample's
+// pdf 0, no light sample. Known kinds: status 0 and their ordinary values.
+TEST_F(SharedOnDevice, UnknownKindsSetTheStatusBitAndSendNothing) {
+  scene_params s{};
+  s.has_medium = 1;
+  s.medium.phase = PHASE_HG;
+  s.medium.g = 0.5f;
+  s.num_lights = 2;
+  std::vector<light_params> lights(2);
+  lights[0].type = LIGHT_POINT;
+  lights[0].corner = nv_float4{0, 0, 2, 0};
+  lights[0].radiance = nv_float4{1, 1, 1, 0};
+  lights[1].type = LIGHT_RECTANGLE;
+  auto probe = [&]() { return run<cl_uint>("sf_scene_kinds", 1, 4, 2, constant(s), input(lights)); };
+  auto bits = [](float f) {
+    cl_uint u;
+    std::memcpy(&u, &f, sizeof u);
+    return u;
+  };
+  // HG(0.5) at μ = 1: (1 − g²) / (4π (1 − g)³) = 0.75 / (4π · 0.125) = 0.477465 (phase.h).
+  std::vector<cl_uint> out = probe();
+  EXPECT_EQ(out[0], 0u);
+  const vec3 w = vec3_make(0.0f, 0.0f, 1.0f);
+  EXPECT_NEAR(phase_hg_eval(0.5f, 1.0f), 0.75f / (4.0f * float(M_PI) * 0.125f), 1e-6f);
+  float value;
+  std::memcpy(&value, &out[1], sizeof value);
+  EXPECT_NEAR(value, phase_eval(PHASE_HG, 0.5f, w, w), 1e-6f);
+  EXPECT_EQ(out[3], 1u);
+
+  s.medium.phase = 7;
+  out = probe();
+  EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
+  EXPECT_EQ(out[1], bits(0.0f));
+  EXPECT_EQ(out[2], bits(0.0f));
+  EXPECT_EQ(out[3], 1u);  // the light is still a known point light
+
+  s.medium.phase = PHASE_ISOTROPIC;
+  lights[1].type = 5;  // the second light: the status says so, the first still lights
+  out = probe();
+  EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
+  EXPECT_EQ(out[1], bits(1.0f / (4.0f * float(M_PI))));
+  EXPECT_EQ(out[3], 1u);
+  lights[0].type = 5;
+  out = probe();
+  EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
+  EXPECT_EQ(out[3], 0u);  // an unknown light sends nothing
+
+  s.has_medium = 0;  // without a medium the phase kind is not looked at
+  s.medium.phase = 7;
+  lights[0].type = lights[1].type = LIGHT_POINT;
+  EXPECT_EQ(probe()[0], 0u);
+}
+
 }  // namespace

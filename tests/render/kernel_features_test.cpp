@@ -130,6 +130,28 @@ void expectSpecialisedEqualsGeneric(const SceneSpec& spec, const DenseGrid* grid
   }
 }
 
+// A kind the kernels do not know is the host's error before any build, with or without
+// specialisation (a host and kernels out of step; the loader never produces one).
+TEST(KernelFeatures, UnknownKindsAreAnErrorOnTheHost) {
+  DeviceScene ds = buildDeviceScene(sceneFromJson(sceneJson({"hg", true, true, true, false})), nullptr);
+  ds.params.medium.phase = 7;
+  try {
+    sceneBuildOptions(ds);
+    FAIL() << "no error";
+  } catch (const std::logic_error& e) {
+    EXPECT_STREQ(e.what(), "the kernels know no phase function kind 7");
+  }
+  ds.params.medium.phase = PHASE_HG;
+  ds.lights[0].type = 5;
+  GenericKernels generic;
+  try {
+    sceneBuildOptions(ds);
+    FAIL() << "no error";
+  } catch (const std::logic_error& e) {
+    EXPECT_STREQ(e.what(), "the kernels know no light kind 5");
+  }
+}
+
 // Each scene switches on a different set of features (see OptionsDerivedFromTheScene).
 TEST(KernelFeatures, HgChromaticBothLightsThinLensSameAsGeneric) {
   const DenseGrid cloud = makeCloud(16, 3);

@@ -1,0 +1,30 @@
+/* scene_kinds.h: every kind the kernels dispatch on by switch, checked once at each kernel's entry.
+ * The switches (phase.h, light.h, march.h) give an unknown kind no contribution; this check makes it
+ * visible: STATUS_UNKNOWN_KIND in the status word, which the host reports. The host validates kinds
+ * before it uploads a scene (render/kernel_features.h), so the bit means host and kernels out of
+ * step, never bad input. */
+#ifndef NARVAL_SCENE_KINDS_H
+#define NARVAL_SCENE_KINDS_H
+
+#include "shared/structs.h"
+
+static inline uint scene_kinds_status(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights) {
+  uint status = 0u;
+  if (s->has_medium) {
+    switch (s->medium.phase) {
+      case PHASE_ISOTROPIC:
+      case PHASE_HG: break;
+      default: status |= STATUS_UNKNOWN_KIND;
+    }
+  }
+  for (int i = 0; i < s->num_lights; ++i) {
+    switch (lights[i].type) {
+      case LIGHT_RECTANGLE:
+      case LIGHT_POINT: break;
+      default: status |= STATUS_UNKNOWN_KIND;
+    }
+  }
+  return status;
+}
+
+#endif
