@@ -101,7 +101,7 @@ nlohmann::ordered_json compareWith(const std::string& refPath, const ImageRGB& i
 int run(const Args& a) {
   Scene scene = loadScene(a.scene, overridesFrom(a));
   for (const std::string& w : scene.warnings) std::cerr << "narval-native: warning: " << w << "\n";
-  const std::string& alg = scene.renderer.algorithm;
+  const std::string alg = algorithmName(scene.renderer.algorithm);
   DenseGrid gridStorage;
   const DenseGrid* grid = loadSceneGrid(scene, gridStorage);
   DeviceScene ds = buildDeviceScene(scene, grid);
@@ -109,7 +109,7 @@ int run(const Args& a) {
   if (a.majorantResolution > 0) setMajorantResolution(ds, a.majorantResolution);
 
   native::NativeOptions o;
-  o.algorithm = alg;
+  o.algorithm = scene.renderer.algorithm;
   o.threads = a.threads;
   o.majorant = a.majorant == "auto" ? "grid" : a.majorant;
   o.spp = scene.renderer.spp;

@@ -65,7 +65,7 @@ static inline float native_fmaxf(float a, float b) { return (a > b || b != b) ? 
 namespace narval::native {
 
 struct NativeOptions {
-  std::string algorithm = "pathtrace";  // pathtrace | raymarch | lobe
+  Algorithm algorithm = Algorithm::Pathtrace;
   int threads = 0;                      // 0: std::thread::hardware_concurrency()
   std::string majorant = "grid";        // pathtrace: grid | global (as narval render --majorant)
   int spp = 1;                          // pathtrace samples per pixel
@@ -98,7 +98,7 @@ inline grid_view nativeGridView(const DeviceScene& ds, const NativeOptions& o) {
   g.nx = ds.grid ? ds.grid->nx : 1;
   g.ny = ds.grid ? ds.grid->ny : 1;
   g.nz = ds.grid ? ds.grid->nz : 1;
-  const bool pathtrace = o.algorithm == "pathtrace";
+  const bool pathtrace = o.algorithm == Algorithm::Pathtrace;
   const bool cells = pathtrace ? (ds.grid != nullptr && o.majorant == "grid") : true;
   g.majorants = cells && !ds.majorants.empty() ? ds.majorants.data() : nullptr;
   return g;
@@ -107,9 +107,9 @@ inline grid_view nativeGridView(const DeviceScene& ds, const NativeOptions& o) {
 // The real-time inputs the device driver (realtime_renderer.cpp) prepares: parameters, lobe
 // directions and the light cache's slabs, for o.algorithm (nothing for pathtrace).
 inline void prepareRealtimeInputs(const Scene& scene, const DeviceScene& ds, NativeOptions& o) {
-  if (o.algorithm == "pathtrace") return;
+  if (!isRealtime(o.algorithm)) return;
   o.realtime = realtimeParams(scene, ds);
-  if (o.algorithm == "lobe") o.lobeDirections = lobeDirections(o.realtime.lobe_points, ds.params, scene.renderer.seed);
+  if (o.algorithm == Algorithm::Lobe) o.lobeDirections = lobeDirections(o.realtime.lobe_points, ds.params, scene.renderer.seed);
   if (o.realtime.ms_cache.nx > 0)
     throw std::invalid_argument("narval-native: the multiple-scattering cache is built on OpenCL devices only");
   if (o.realtime.light_cache.nx > 0) {
@@ -119,16 +119,14 @@ inline void prepareRealtimeInputs(const Scene& scene, const DeviceScene& ds, Nat
 }
 
 // Renders ds with the shared headers on host threads. Throws std::invalid_argument for an unknown
-// algorithm or majorant, or lobe without directions.
+// majorant, or lobe without directions.
 inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) {
-  const std::string& alg = o.algorithm;
-  if (alg != "pathtrace" && alg != "raymarch" && alg != "lobe")
-    throw std::invalid_argument("renderNative: unknown algorithm '" + alg + "'");
+  const Algorithm alg = o.algorithm;
   if (o.majorant != "grid" && o.majorant != "global")
     throw std::invalid_argument("renderNative: majorant must be grid or global, got '" + o.majorant + "'");
-  if (alg == "lobe" && o.lobeDirections.empty())
+  if (alg == Algorithm::Lobe && o.lobeDirections.empty())
     throw std::invalid_argument("renderNative: lobe needs its directions");
-  if (alg != "pathtrace" && o.realtime.light_cache.nx > 0 && o.lightCache.empty())
+  if (isRealtime(alg) && o.realtime.light_cache.nx > 0 && o.lightCache.empty())
     throw std::invalid_argument("renderNative: the light cache is on but was not built");
   const scene_params* sp = &ds.params;
   const light_params* lights = ds.lights.data();
@@ -139,7 +137,6 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
   const realtime_params* rp = &o.realtime;
   const nv_float4* dirs = o.lobeDirections.data();
   const float* cache = o.lightCache.data();
-  const int kind = alg == "pathtrace" ? 0 : (alg == "raymarch" ? 1 : 2);
 
   // RGBA as the kernels write it: pathtrace the Kahan sums (A = 0), real-time the value.
   std::vector<float> rgba(size_t(W) * size_t(H) * 4, 0.0f);
@@ -151,20 +148,23 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
          y = nextRow.fetch_add(1, std::memory_order_relaxed)) {
       float* row = rgba.data() + size_t(y) * size_t(W) * 4;
       for (int x = 0; x < W; ++x) {
-        vec3 L;
-        if (kind == 0) {
-          float ax = 0.0f, ay = 0.0f, az = 0.0f, cx = 0.0f, cy = 0.0f, cz = 0.0f;
-          for (int s = 0; s < spp; ++s) {
-            const vec3 v = pathtrace_sample(sp, lights, grid, x, y, uint(s), &status);
-            accum_kahan_add(&ax, &cx, v.x);
-            accum_kahan_add(&ay, &cy, v.y);
-            accum_kahan_add(&az, &cz, v.z);
+        vec3 L = vec3_splat(0.0f);
+        switch (alg) {
+          case Algorithm::Pathtrace: {
+            float ax = 0.0f, ay = 0.0f, az = 0.0f, cx = 0.0f, cy = 0.0f, cz = 0.0f;
+            for (int s = 0; s < spp; ++s) {
+              const vec3 v = pathtrace_sample(sp, lights, grid, x, y, uint(s), &status);
+              accum_kahan_add(&ax, &cx, v.x);
+              accum_kahan_add(&ay, &cy, v.y);
+              accum_kahan_add(&az, &cz, v.z);
+            }
+            L = vec3_make(ax, ay, az);
+            break;
           }
-          L = vec3_make(ax, ay, az);
-        } else if (kind == 1) {
-          L = raymarch_pixel(sp, lights, grid, rp, cache, o.msCache.data(), x, y, &status);
-        } else {
-          L = lobe_pixel(sp, lights, grid, rp, dirs, cache, x, y, &status);
+          case Algorithm::Raymarch:
+            L = raymarch_pixel(sp, lights, grid, rp, cache, o.msCache.data(), x, y, &status);
+            break;
+          case Algorithm::Lobe: L = lobe_pixel(sp, lights, grid, rp, dirs, cache, x, y, &status); break;
         }
         row[size_t(x) * 4 + 0] = L.x;
         row[size_t(x) * 4 + 1] = L.y;
@@ -183,7 +183,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
   for (std::thread& t : pool) t.join();
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.status = statusAll.load();
-  r.image = imageFromRgba(rgba, W, H, alg == "pathtrace" ? float(spp) : 1.0f, &r.nanPixels);
+  r.image = imageFromRgba(rgba, W, H, alg == Algorithm::Pathtrace ? float(spp) : 1.0f, &r.nanPixels);
   return r;
 }
 

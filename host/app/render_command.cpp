@@ -120,10 +120,11 @@ void resumeMajorant(const std::string& out, const RenderArgs& a, std::string* ma
 int runRender(const RenderArgs& a) {
   Scene scene = loadScene(a.scene, overridesFrom(a));
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
-  const bool realtime = scene.renderer.algorithm != "pathtrace";
+  const bool realtime = isRealtime(scene.renderer.algorithm);
+  const std::string algorithm = algorithmName(scene.renderer.algorithm);
   const auto [lx, ly] = parseSize(a.localSize, "--local-size");
   if (a.counters && realtime)
-    throw inputError("--counters", "", "only the path tracer counts collisions; the algorithm is " + scene.renderer.algorithm);
+    throw inputError("--counters", "", "only the path tracer counts collisions; the algorithm is " + algorithm);
 
   fs::path out = a.out.empty() ? fs::path(fs::path(a.scene).stem().string() + ".exr") : fs::path(a.out);
   if (out.extension() != ".exr") throw inputError("-o", "", "the output must be an .exr file, got '" + a.out + "'");
@@ -136,7 +137,7 @@ int runRender(const RenderArgs& a) {
   AccumulatorState resumeState;
   bool resuming = false;
   if (a.resume) {
-    if (realtime) throw inputError("--resume", "", "only path-traced renders resume; the algorithm is " + scene.renderer.algorithm);
+    if (realtime) throw inputError("--resume", "", "only path-traced renders resume; the algorithm is " + algorithm);
     if (fs::exists(out)) {
       resumeState = readAccumulator(out.string(), scene);
       resuming = true;
@@ -154,7 +155,7 @@ int runRender(const RenderArgs& a) {
   if (!a.displayServer.empty()) displayAt = parseHostPort(a.displayServer, "--display-server");
   if (a.partialEverySeconds > 0 && realtime)
     throw inputError("--write-partial-images", "", "only path-traced renders write partial images; the algorithm is " +
-                                                       scene.renderer.algorithm);
+                                                       algorithm);
 
   // Everything the render needs is loaded and checked before the first sample.
   DenseGrid gridStorage;

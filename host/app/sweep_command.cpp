@@ -73,10 +73,10 @@ int runSweepCommand(const SweepArgs& a) {
   if (!a.resolution.empty()) overrides.push_back(resolutionOverride(a.resolution));
   Scene scene = loadScene(a.scene, overrides);
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
-  if (scene.renderer.algorithm != "pathtrace" && a.algorithm.empty())
-    std::cerr << "narval: warning: " << a.scene << ": renderer.algorithm is \"" << scene.renderer.algorithm
+  if (scene.renderer.algorithm != Algorithm::Pathtrace && a.algorithm.empty())
+    std::cerr << "narval: warning: " << a.scene << ": renderer.algorithm is \"" << algorithmName(scene.renderer.algorithm)
               << "\"; the sweep renders with pathtrace\n";
-  scene.renderer.algorithm = "pathtrace";
+  scene.renderer.algorithm = Algorithm::Pathtrace;
 
   const fs::path dir(a.out);
   if (fs::exists(dir) && !fs::is_directory(dir))

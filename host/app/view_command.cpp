@@ -96,7 +96,7 @@ int runView(const ViewArgs& a) {
                         {"frames_per_resolution", session.framesPerResolution()},
                         {"per_resolution", perResolution},
                         {"present_ms_median", median(window.presentMs())},
-                        {"algorithm", session.algorithm()},
+                        {"algorithm", algorithmName(session.algorithm())},
                         {"last_frame_ms", session.lastFrameMs()},
                         {"device", rt.selected.info.name},
                         // Frames go through the host; whether the device could share them with OpenGL:

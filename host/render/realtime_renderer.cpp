@@ -18,7 +18,7 @@ namespace narval {
 
 realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes) {
   const RendererSettings& r = scene.renderer;
-  const bool lobe = r.algorithm == "lobe";
+  const bool lobe = r.algorithm == Algorithm::Lobe;
   realtime_params p{};
   p.steps = lobe ? r.lobe.firstHitSteps : r.raymarch.steps;
   p.shadow_steps = lobe ? r.lobe.shadowSteps : r.raymarch.shadowSteps;
@@ -54,7 +54,7 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
 RealtimeRenderer::RealtimeRenderer(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
                                    const RenderOptions& options)
     : rt_(rt), view_(scene), options_(options), dev_(rt, checkedScene(scene, options), grid) {
-  const std::string& algorithm = scene.renderer.algorithm;
+  const std::string algorithm = algorithmName(scene.renderer.algorithm);
   warnings_ = dev_.scene.warnings;
   stats_ = initialStats(algorithm, rt, scene);
   recordGridStorage(stats_, dev_);
@@ -80,16 +80,17 @@ RealtimeRenderer::RealtimeRenderer(ClRuntime& rt, const Scene& scene, const Dens
 }
 
 const Scene& RealtimeRenderer::checkedScene(const Scene& scene, const RenderOptions& options) {
-  const std::string& algorithm = scene.renderer.algorithm;
-  if (algorithm != "raymarch" && algorithm != "lobe")
-    throw std::invalid_argument("RealtimeRenderer: not a real-time algorithm: " + algorithm);
+  if (!isRealtime(scene.renderer.algorithm))
+    throw std::invalid_argument(std::string("RealtimeRenderer: not a real-time algorithm: ") +
+                                algorithmName(scene.renderer.algorithm));
   checkMajorantOptions(options);
   return scene;
 }
 
 void RealtimeRenderer::setView(const Scene& view) {
   if (view.renderer.algorithm != view_.renderer.algorithm)
-    throw std::invalid_argument("RealtimeRenderer::setView: another algorithm (" + view.renderer.algorithm + ")");
+    throw std::invalid_argument(std::string("RealtimeRenderer::setView: another algorithm (") +
+                                algorithmName(view.renderer.algorithm) + ")");
   const int W = view.renderer.width, H = view.renderer.height;
   const bool resized = W != view_.renderer.width || H != view_.renderer.height;
   const camera_params camera = buildCamera(view);
@@ -106,7 +107,7 @@ void RealtimeRenderer::setView(const Scene& view) {
   }
   // The lobe's directions depend on its point count (and g, seed: the scene's); one dummy otherwise.
   if (params.lobe_points != params_.lobe_points || !dirBuf_()) {
-    std::vector<nv_float4> dirs = view.renderer.algorithm == "lobe"
+    std::vector<nv_float4> dirs = view.renderer.algorithm == Algorithm::Lobe
                                       ? lobeDirections(params.lobe_points, dev_.scene.params, view.renderer.seed)
                                       : std::vector<nv_float4>(1, nv_float4{0, 0, 1, 0});
     dirCount_ = dirs.size();
@@ -142,7 +143,7 @@ double RealtimeRenderer::renderFrame(bool progressiveCache, double* wallMs) {
                              sizeof(params_) + dirCount_ * sizeof(nv_float4) + lightCache_.bytes() + msCache_.bytes();
   const auto t0 = std::chrono::steady_clock::now();
   const cl::Event ev = launchAndWait(rt_, kernel_.get(), paddedGlobalRange(W, H, options_), localRange(options_),
-                                     view_.renderer.algorithm, deviceBytes);
+                                     algorithmName(view_.renderer.algorithm), deviceBytes);
   if (wallMs) *wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ++stats_.passes;
   return eventSeconds(ev) * 1e3;

@@ -106,7 +106,7 @@ SweepResult runSweep(const Scene& scene, const SweepSpec& spec, const SweepRende
 
   auto sceneFor = [&](int value) {
     Scene s = scene;
-    s.renderer.algorithm = "pathtrace";
+    s.renderer.algorithm = Algorithm::Pathtrace;
     (spec.parameter == SweepParameter::Spp ? s.renderer.spp : s.renderer.bounces) = value;
     return s;
   };

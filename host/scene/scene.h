@@ -105,6 +105,16 @@ struct RaymarchSettings {
 // The Lobe Estimator: the dissertation's Eq. 7, or the corrected estimator (kernels/shared/lobe.h).
 enum class LobeVariant { Eq7, Corrected };
 
+// What renders the scene (renderer.algorithm): the unbiased path tracer, or one of the real-time
+// kernels (the ray marcher, the dissertation's Lobe Estimator).
+enum class Algorithm { Pathtrace, Raymarch, Lobe };
+// "pathtrace", "raymarch", "lobe": the scene key's values and the names in outputs.
+const char* algorithmName(Algorithm a);
+// Raymarch and Lobe: one launch a frame, no samples to accumulate.
+bool isRealtime(Algorithm a);
+// The algorithm called `name` (algorithmName's inverse); false, *out untouched, for any other name.
+bool algorithmFromName(const std::string& name, Algorithm* out);
+
 struct LobeSettings {
   LobeVariant variant = LobeVariant::Eq7;
   float depthFactor = 20.0f;
@@ -132,7 +142,7 @@ struct RendererSettings {
   bool hdr = true;
   ToneMapping toneMapping = ToneMapping::Aces;  // JSON true -> Aces, false -> None, or a name
   float exposure = 0.0f;                        // stops
-  std::string algorithm = "pathtrace";          // pathtrace | raymarch | lobe
+  Algorithm algorithm = Algorithm::Pathtrace;
   uint32_t seed = 0;
   GridStorage storage = GridStorage::Auto;
   RaymarchSettings raymarch;

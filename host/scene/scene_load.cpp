@@ -153,9 +153,9 @@ const EnumNames<MultipleScattering> kMultipleScattering = {{"none", MultipleScat
                                                            {"octaves", MultipleScattering::Octaves},
                                                            {"cache", MultipleScattering::Cache}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
-const EnumNames<std::string> kAlgorithms = {{"pathtrace", "pathtrace"},
-                                            {"raymarch", "raymarch"},
-                                            {"lobe", "lobe"}};
+const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
+                                          {"raymarch", Algorithm::Raymarch},
+                                          {"lobe", Algorithm::Lobe}};
 
 const char* materialTypeName(MaterialType t) { return t == MaterialType::Emitter ? "emitter" : "volume"; }
 const char* primitiveTypeName(PrimitiveType t) {
@@ -528,6 +528,33 @@ const char* gridStorageName(GridStorage s) {
   for (const auto& [name, value] : kGridStorages)
     if (value == s) return name;
   return "auto";
+}
+
+const char* algorithmName(Algorithm a) {
+  switch (a) {
+    case Algorithm::Pathtrace: return "pathtrace";
+    case Algorithm::Raymarch: return "raymarch";
+    case Algorithm::Lobe: return "lobe";
+  }
+  throw std::logic_error("algorithmName: not an Algorithm");
+}
+
+bool isRealtime(Algorithm a) {
+  switch (a) {
+    case Algorithm::Pathtrace: return false;
+    case Algorithm::Raymarch:
+    case Algorithm::Lobe: return true;
+  }
+  throw std::logic_error("isRealtime: not an Algorithm");
+}
+
+bool algorithmFromName(const std::string& name, Algorithm* out) {
+  for (const auto& [n, a] : kAlgorithms)
+    if (name == n) {
+      *out = a;
+      return true;
+    }
+  return false;
 }
 
 }  // namespace narval

@@ -97,7 +97,9 @@ void ViewerSession::apply(const ViewerInput& input) {
     case ViewerInput::Kind::Key:
       switch (input.key) {
         case '1': case '2': case '3': {
-          const std::string next = input.key == '1' ? "pathtrace" : input.key == '2' ? "raymarch" : "lobe";
+          const Algorithm next = input.key == '1'   ? Algorithm::Pathtrace
+                                 : input.key == '2' ? Algorithm::Raymarch
+                                                    : Algorithm::Lobe;
           if (next != algorithm_) {
             algorithm_ = next;
             restart_ = true;
@@ -106,16 +108,21 @@ void ViewerSession::apply(const ViewerInput& input) {
         }
         case '[': case ']': {
           const bool up = input.key == ']';
-          if (algorithm_ == "raymarch")
-            raymarchSteps_ = up ? std::min(4096, raymarchSteps_ * 3 / 2 + 1) : std::max(2, raymarchSteps_ * 2 / 3);
-          else if (algorithm_ == "lobe")
-            lobePoints_ = up ? std::min(1024, lobePoints_ * 2) : std::max(1, lobePoints_ / 2);
-          else
-            pathtraceSppPerFrame_ = up ? std::min(256, pathtraceSppPerFrame_ * 2) : std::max(1, pathtraceSppPerFrame_ / 2);
-          messages_.push_back(algorithm_ == "raymarch"    ? "raymarch: " + std::to_string(raymarchSteps_) + " steps"
-                              : algorithm_ == "lobe"      ? "lobe: " + std::to_string(lobePoints_) + " lobe points"
-                                                          : "pathtrace: " + std::to_string(pathtraceSppPerFrame_) +
-                                                                " spp per frame");
+          switch (algorithm_) {
+            case Algorithm::Raymarch:
+              raymarchSteps_ = up ? std::min(4096, raymarchSteps_ * 3 / 2 + 1) : std::max(2, raymarchSteps_ * 2 / 3);
+              messages_.push_back("raymarch: " + std::to_string(raymarchSteps_) + " steps");
+              break;
+            case Algorithm::Lobe:
+              lobePoints_ = up ? std::min(1024, lobePoints_ * 2) : std::max(1, lobePoints_ / 2);
+              messages_.push_back("lobe: " + std::to_string(lobePoints_) + " lobe points");
+              break;
+            case Algorithm::Pathtrace:
+              pathtraceSppPerFrame_ =
+                  up ? std::min(256, pathtraceSppPerFrame_ * 2) : std::max(1, pathtraceSppPerFrame_ / 2);
+              messages_.push_back("pathtrace: " + std::to_string(pathtraceSppPerFrame_) + " spp per frame");
+              break;
+          }
           break;
         }
         case 'P': snapshot_ = true; break;
@@ -141,14 +148,14 @@ void ViewerSession::apply(const ViewerInput& input) {
 }
 
 bool ViewerSession::idle() const {
-  return algorithm_ == "pathtrace" && !moved_ && !restart_ && !snapshot_ && pathtrace_ &&
+  return algorithm_ == Algorithm::Pathtrace && !moved_ && !restart_ && !snapshot_ && pathtrace_ &&
          pathtrace_->samples() >= scene_.renderer.spp && lastWidth_ == scene_.renderer.width;
 }
 
 int ViewerSession::chooseLevel() const {
   const auto it = msPerPixel_.find(algorithm_);
   if (it == msPerPixel_.end()) return 1;  // nothing measured yet: full size
-  const double perSample = algorithm_ == "pathtrace" ? pathtraceSppPerFrame_ : 1;
+  const double perSample = algorithm_ == Algorithm::Pathtrace ? pathtraceSppPerFrame_ : 1;
   const double fullPixels = double(scene_.renderer.width) * scene_.renderer.height;
   for (const int level : kLevels)
     if (it->second * perSample * fullPixels / (level * level) <= options_.targetMs) return level;
@@ -156,7 +163,7 @@ int ViewerSession::chooseLevel() const {
 }
 
 RealtimeRenderer& ViewerSession::realtime(const Scene& view) {
-  std::unique_ptr<RealtimeRenderer>& r = algorithm_ == "raymarch" ? raymarch_ : lobe_;
+  std::unique_ptr<RealtimeRenderer>& r = algorithm_ == Algorithm::Raymarch ? raymarch_ : lobe_;
   if (!r) {
     r = std::make_unique<RealtimeRenderer>(rt_, view, grid_, options_.render);
     for (const std::string& w : r->warnings()) messages_.push_back("warning: " + w);
@@ -195,7 +202,7 @@ void ViewerSession::renderFrame() {
 
   RenderResult result;
   double ms = 0;
-  if (algorithm_ == "pathtrace") {
+  if (algorithm_ == Algorithm::Pathtrace) {
     PathtraceRenderer& r = pathtrace(view);
     // While moving each frame starts over; when still, frames add samples up to the scene's spp.
     if (moving) r.reset();
@@ -211,7 +218,8 @@ void ViewerSession::renderFrame() {
     result = r.result();
     spp_ = 1;
   }
-  if (ms > 0) msPerPixel_[algorithm_] = ms / (double(W) * H * (algorithm_ == "pathtrace" ? pathtraceSppPerFrame_ : 1));
+  if (ms > 0)
+    msPerPixel_[algorithm_] = ms / (double(W) * H * (algorithm_ == Algorithm::Pathtrace ? pathtraceSppPerFrame_ : 1));
   lastMs_ = ms;
   ++frames_;
   ++framesPerResolution_[sizeName(W, H)];
@@ -231,7 +239,7 @@ void ViewerSession::renderFrame() {
   times.kernelMs.push_back(ms);
   times.frameMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   if (snapshot_) {
-    if (algorithm_ == "pathtrace") view.renderer.spp = spp_;
+    if (algorithm_ == Algorithm::Pathtrace) view.renderer.spp = spp_;
     writeSnapshot(result, view);
   }
   moved_ = restart_ = snapshot_ = false;
@@ -254,7 +262,7 @@ void ViewerSession::compose(const ImageRGB& image) {
   if (!help_) return;
   // The help overlay: a dimmed box with the keys, then the status line, at the top left.
   std::vector<std::string> lines(std::begin(kHelp), std::end(kHelp));
-  lines.push_back(algorithm_ + "  " + fixed(lastMs_, 1) + " MS  " + sizeName(lastWidth_, lastHeight_) + "  " +
+  lines.push_back(algorithmName(algorithm_) + std::string("  ") + fixed(lastMs_, 1) + " MS  " + sizeName(lastWidth_, lastHeight_) + "  " +
                   std::to_string(spp_) + " SPP");
   if (liveError_.valid)
     lines.push_back("DE76 " + fixed(liveError_.meanDeltaE76, 2) + "  JND " + fixed(liveError_.jndPercent, 1) + "%");
@@ -292,20 +300,22 @@ void ViewerSession::writeSnapshot(const RenderResult& result, const Scene& view)
   doc["camera"]["position"] = vec(view.camera.position);
   doc["camera"]["lookAt"] = vec(view.camera.lookAt);
   doc["camera"]["up"] = vec(view.camera.up);
-  doc["renderer"]["algorithm"] = view.renderer.algorithm;
+  doc["renderer"]["algorithm"] = algorithmName(view.renderer.algorithm);
   doc["renderer"]["resolution"] = {view.renderer.width, view.renderer.height};
-  if (view.renderer.algorithm == "pathtrace") doc["renderer"]["spp"] = view.renderer.spp;
-  if (view.renderer.algorithm == "raymarch") doc["renderer"]["raymarch"]["steps"] = view.renderer.raymarch.steps;
-  if (view.renderer.algorithm == "lobe") doc["renderer"]["lobe"]["lobePoints"] = view.renderer.lobe.lobePoints;
+  switch (view.renderer.algorithm) {  // its quality parameter ([ ]), and the path tracer's spp so far
+    case Algorithm::Pathtrace: doc["renderer"]["spp"] = view.renderer.spp; break;
+    case Algorithm::Raymarch: doc["renderer"]["raymarch"]["steps"] = view.renderer.raymarch.steps; break;
+    case Algorithm::Lobe: doc["renderer"]["lobe"]["lobePoints"] = view.renderer.lobe.lobePoints; break;
+  }
   for (size_t i = 0; i < view.materials.size() && doc.contains("materials") && i < doc["materials"].size(); ++i)
     if (!view.materials[i].path.empty() && doc["materials"][i].contains("path"))
       doc["materials"][i]["path"] = fs::absolute(view.materials[i].path).lexically_normal().string();
   writeRenderExr(base.string() + ".exr", result, view);
   writePng(base.string() + ".png", result.image, view.renderer.exposure, view.renderer.toneMapping);
   writeTextAtomic(base.string() + ".json", doc.dump(2) + "\n");
-  messages_.push_back("wrote " + base.string() + ".exr, .png and .json (" + view.renderer.algorithm + ", " +
+  messages_.push_back("wrote " + base.string() + ".exr, .png and .json (" + algorithmName(view.renderer.algorithm) + ", " +
                       sizeName(view.renderer.width, view.renderer.height) +
-                      (view.renderer.algorithm == "pathtrace" ? ", " + std::to_string(spp_) + " spp" : "") + ")");
+                      (view.renderer.algorithm == Algorithm::Pathtrace ? ", " + std::to_string(spp_) + " spp" : "") + ")");
 }
 
 std::vector<std::string> ViewerSession::takeMessages() {
@@ -315,7 +325,7 @@ std::vector<std::string> ViewerSession::takeMessages() {
 }
 
 std::string ViewerSession::title() const {
-  std::string t = "narval view: " + fs::path(scene_.sourcePath).filename().string() + " | " + algorithm_ + " | " +
+  std::string t = "narval view: " + fs::path(scene_.sourcePath).filename().string() + " | " + algorithmName(algorithm_) + " | " +
                   fixed(lastMs_, 1) + " ms | " + sizeName(lastWidth_, lastHeight_) + " | " + std::to_string(spp_) +
                   " spp | " + rt_.selected.info.name;
   if (liveError_.valid)

@@ -63,7 +63,7 @@ class ViewerSession {
   int frames() const { return frames_; }
   // Lines for the user (snapshots written, warnings), taken once.
   std::vector<std::string> takeMessages();
-  const std::string& algorithm() const { return algorithm_; }
+  Algorithm algorithm() const { return algorithm_; }
   double lastFrameMs() const { return lastMs_; }
   // Live comparison with --reference (valid() false when there is none or the camera is elsewhere).
   struct LiveError {
@@ -86,7 +86,7 @@ class ViewerSession {
   const DenseGrid* grid_;
   ViewerOptions options_;
   OrbitCamera camera_;
-  std::string algorithm_;
+  Algorithm algorithm_;
   int raymarchSteps_, lobePoints_, pathtraceSppPerFrame_ = 1;
   bool moved_ = true;       // the camera changed since the last frame
   bool restart_ = true;     // the path tracer starts over at the next frame
@@ -95,7 +95,7 @@ class ViewerSession {
   std::unique_ptr<RealtimeRenderer> raymarch_, lobe_;
   std::unique_ptr<PathtraceRenderer> pathtrace_;
   std::string pathtraceViewKey_;  // the view the path tracer accumulates
-  std::map<std::string, double> msPerPixel_;  // per algorithm: the last frame's kernel ms per pixel (and sample)
+  std::map<Algorithm, double> msPerPixel_;  // per algorithm: the last frame's kernel ms per pixel (and sample)
   ImageRGB8 display_;
   int frames_ = 0, lastWidth_ = 0, lastHeight_ = 0, spp_ = 0;
   double lastMs_ = 0;

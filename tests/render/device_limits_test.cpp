@@ -155,7 +155,7 @@ TEST(DeviceLimits, RenderersReportAnImageTooLargeForTheDevice) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), "box.json: renderer.resolution: an accumulator of 16x16" + tail);
   }
-  scene.renderer.algorithm = "raymarch";
+  scene.renderer.algorithm = Algorithm::Raymarch;
   try {
     renderRealtime(small, scene, nullptr, 1, {});
     FAIL() << "expected InputError";

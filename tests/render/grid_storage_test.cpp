@@ -131,7 +131,7 @@ void expectSamePixels(const std::string& name, const Scene& scene, const DenseGr
     return;
   }
   const size_t pixels = size_t(scene.renderer.width) * size_t(scene.renderer.height);
-  if (scene.renderer.algorithm == "pathtrace")
+  if (scene.renderer.algorithm == Algorithm::Pathtrace)
     EXPECT_LE(r.outside, pixels / 100) << name << ": more flipped delta-tracking decisions than rounding explains";
   else
     EXPECT_EQ(r.outside, 0u) << name;
@@ -199,7 +199,7 @@ TEST(GridStorage, DisneyCloudSamePixelsEveryAlgorithm) {
   const DenseGrid disney = loadGrid(path, "density");
   for (const char* algorithm : {"pathtrace", "raymarch", "lobe"}) {
     Scene s = sceneFromJson(listing41Json(path));
-    s.renderer.algorithm = algorithm;
+    ASSERT_TRUE(algorithmFromName(algorithm, &s.renderer.algorithm));
     s.renderer.width = 48;
     s.renderer.height = 24;
     s.renderer.spp = 8;

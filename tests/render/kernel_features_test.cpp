@@ -113,7 +113,7 @@ void expectSpecialisedEqualsGeneric(const SceneSpec& spec, const DenseGrid* grid
   unsetenv("NARVAL_GENERIC");
   for (const char* algorithm : {"pathtrace", "raymarch", "lobe"}) {
     Scene scene = sceneFromJson(sceneJson(spec));
-    scene.renderer.algorithm = algorithm;
+    ASSERT_TRUE(algorithmFromName(algorithm, &scene.renderer.algorithm));
     const RenderResult specialised = renderAlgorithm(scene, grid);
     RenderResult generic;
     {

@@ -18,7 +18,7 @@ namespace narval::test {
 namespace {
 
 RenderResult renderLobeVariant(Scene scene, LobeVariant variant, const DenseGrid* grid = nullptr) {
-  scene.renderer.algorithm = "lobe";
+  scene.renderer.algorithm = Algorithm::Lobe;
   scene.renderer.lobe.variant = variant;
   return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
 }

@@ -20,7 +20,7 @@ namespace narval::test {
 namespace {
 
 RenderResult renderLobe(Scene scene, const DenseGrid* grid = nullptr, int lx = 8, int ly = 8) {
-  scene.renderer.algorithm = "lobe";
+  scene.renderer.algorithm = Algorithm::Lobe;
   RenderOptions o;
   o.localSizeX = lx;
   o.localSizeY = ly;
@@ -113,7 +113,7 @@ TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
                           "viewSteps": 100, "minTransmittance": 0}},
     "background": [0.2, 0.3, 0.4]
   })");
-  scene.renderer.algorithm = "lobe";
+  scene.renderer.algorithm = Algorithm::Lobe;
   const RenderResult r = renderLobe(scene);
   ASSERT_EQ(r.stats.status, 0u);
   const DeviceScene ds = buildDeviceScene(scene, nullptr);

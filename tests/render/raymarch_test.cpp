@@ -24,7 +24,7 @@ constexpr double kPi = 3.14159265358979323846;
 // Exact marching: these tests check the march's own quadrature against closed forms, so the light
 // cache and early termination are off here (their bounds: light_cache_render_test.cpp).
 RenderResult raymarch(Scene scene, const DenseGrid* grid = nullptr, int lx = 8, int ly = 8) {
-  scene.renderer.algorithm = "raymarch";
+  scene.renderer.algorithm = Algorithm::Raymarch;
   scene.renderer.lightCache.resolution = 0;
   scene.renderer.raymarch.minTransmittance = 0;
   RenderOptions o;

@@ -35,7 +35,7 @@ inline RenderResult render(const Scene& scene, const DenseGrid* grid = nullptr, 
 
 // The scene's own renderer.algorithm (one frame for the real-time ones).
 inline RenderResult renderAlgorithm(const Scene& scene, const DenseGrid* grid = nullptr) {
-  if (scene.renderer.algorithm == "pathtrace") return render(scene, grid);
+  if (scene.renderer.algorithm == Algorithm::Pathtrace) return render(scene, grid);
   return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
 }
 
@@ -50,22 +50,22 @@ inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "rayma
 // real-time ones.
 inline RenderResult renderWith(Scene scene, const std::string& renderer, const DenseGrid* grid = nullptr) {
   if (renderer == "raymarch+ms-cache") {
-    scene.renderer.algorithm = "raymarch";
+    scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
     scene.renderer.raymarch.msCache.resolution = 4;
     scene.renderer.raymarch.msCache.paths = 8;
     scene.renderer.raymarch.areaLightSamples = 2;  // and the phase over a rectangle's area
   } else if (renderer == "raymarch+octaves") {
-    scene.renderer.algorithm = "raymarch";
+    scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Octaves;
     scene.renderer.raymarch.octaves = 3;
   } else if (renderer == "lobe+corrected") {
-    scene.renderer.algorithm = "lobe";
+    scene.renderer.algorithm = Algorithm::Lobe;
     scene.renderer.lobe.variant = LobeVariant::Corrected;
-  } else {
-    scene.renderer.algorithm = renderer;
+  } else if (!algorithmFromName(renderer, &scene.renderer.algorithm)) {
+    throw std::invalid_argument("renderWith: no renderer called '" + renderer + "'");
   }
-  if (scene.renderer.algorithm == "pathtrace") return render(scene, grid);
+  if (scene.renderer.algorithm == Algorithm::Pathtrace) return render(scene, grid);
   return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
 }
 

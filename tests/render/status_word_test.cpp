@@ -40,7 +40,7 @@ RenderResult renderOn(ClRuntime& rt, Scene scene, const DenseGrid* grid, const s
   RenderOptions o;
   o.majorant = majorant;
   if (algorithm == "pathtrace") return renderPathtrace(rt, scene, grid, o);
-  scene.renderer.algorithm = algorithm;
+  if (!algorithmFromName(algorithm, &scene.renderer.algorithm)) throw std::invalid_argument(algorithm);
   return renderRealtime(rt, scene, grid, 1, o);
 }
 RenderResult renderWith(const Scene& scene, const DenseGrid* grid, const std::string& algorithm,

@@ -21,7 +21,7 @@ namespace {
 const std::string kLitCloud = litCloudJson(R"({"resolution": [24, 17], "spp": 8, "bounces": 6, "seed": 5})",
                                            "[1.0, 1.3, 1.6]", "[0.05, 0.02, 0.02]");
 
-native::NativeOptions optionsFor(const Scene& scene, const DeviceScene& ds, const std::string& algorithm) {
+native::NativeOptions optionsFor(const Scene& scene, const DeviceScene& ds, Algorithm algorithm) {
   native::NativeOptions o;
   o.algorithm = algorithm;
   o.spp = scene.renderer.spp;
@@ -36,10 +36,11 @@ TEST(NativeRender, ThreadCountNeverChangesTheBits) {
   const DenseGrid cloud = makeCloud(24, 3);
   const Scene scene = sceneFromJson(kLitCloud);
   const DeviceScene ds = buildDeviceScene(scene, &cloud);
-  for (const char* alg : {"pathtrace", "raymarch", "lobe"})
+  for (const Algorithm algorithm : {Algorithm::Pathtrace, Algorithm::Raymarch, Algorithm::Lobe})
     for (const char* majorant : {"grid", "global"}) {
-      if (std::string(alg) != "pathtrace" && std::string(majorant) == "global") continue;
-      native::NativeOptions o = optionsFor(scene, ds, alg);
+      if (isRealtime(algorithm) && std::string(majorant) == "global") continue;
+      const std::string alg = algorithmName(algorithm);
+      native::NativeOptions o = optionsFor(scene, ds, algorithm);
       o.majorant = majorant;
       o.threads = 1;
       const native::NativeResult one = native::renderNative(ds, o);
@@ -66,7 +67,7 @@ TEST(NativeRender, SeedDeterminesThePathTracedImage) {
   Scene scene = sceneFromJson(kLitCloud);
   scene.renderer.spp = 2;
   const DeviceScene ds = buildDeviceScene(scene, &cloud);
-  const native::NativeOptions o = optionsFor(scene, ds, "pathtrace");
+  const native::NativeOptions o = optionsFor(scene, ds, Algorithm::Pathtrace);
   const ImageRGB a = native::renderNative(ds, o).image, b = native::renderNative(ds, o).image;
   EXPECT_EQ(a.rgb, b.rgb);
   scene.renderer.seed = 6;
@@ -89,7 +90,7 @@ TEST(NativeRender, AbsorptionBoxGivesBeerLambert) {
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x) expected += absorptionBoxTransmittance(c, x, y) / 256.0;
 
-  const native::NativeResult pt = native::renderNative(ds, optionsFor(scene, ds, "pathtrace"));
+  const native::NativeResult pt = native::renderNative(ds, optionsFor(scene, ds, Algorithm::Pathtrace));
   EXPECT_EQ(pt.status, 0u);
   EXPECT_EQ(pt.nanPixels, 0);
   for (int ch = 0; ch < 3; ++ch) {
@@ -99,7 +100,7 @@ TEST(NativeRender, AbsorptionBoxGivesBeerLambert) {
     EXPECT_NEAR(s.mean / kAbsorptionBoxLe[ch], expected, 0.005 * expected) << "channel " << ch;
   }
 
-  const native::NativeResult rm = native::renderNative(ds, optionsFor(scene, ds, "raymarch"));
+  const native::NativeResult rm = native::renderNative(ds, optionsFor(scene, ds, Algorithm::Raymarch));
   EXPECT_EQ(rm.status, 0u);
   double worst = 0;
   for (int y = 0; y < 16; ++y)
@@ -113,17 +114,16 @@ TEST(NativeRender, AbsorptionBoxGivesBeerLambert) {
   std::printf("[ native ] absorption box, raymarch: worst relative error %.2e\n", worst);
 }
 
-TEST(NativeRender, RejectsUnknownAlgorithmAndMajorant) {
+// (An unknown algorithm cannot be asked for: NativeOptions::algorithm is an Algorithm.)
+TEST(NativeRender, RejectsUnknownMajorantAndLobeWithoutDirections) {
   const Scene scene = sceneFromJson(absorptionBoxJson(R"({"resolution": [2, 2], "spp": 1})"));
   const DeviceScene ds = buildDeviceScene(scene, nullptr);
   native::NativeOptions o;
-  o.algorithm = "photon";
-  EXPECT_THROW(native::renderNative(ds, o), std::invalid_argument);
-  o.algorithm = "pathtrace";
+  o.algorithm = Algorithm::Pathtrace;
   o.majorant = "local";
   EXPECT_THROW(native::renderNative(ds, o), std::invalid_argument);
   o.majorant = "grid";
-  o.algorithm = "lobe";  // without directions
+  o.algorithm = Algorithm::Lobe;  // without directions
   EXPECT_THROW(native::renderNative(ds, o), std::invalid_argument);
 }
 

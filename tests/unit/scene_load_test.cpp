@@ -139,7 +139,7 @@ TEST_F(SceneFiles, Listing41LoadsAsPrinted) {
   EXPECT_EQ(s.renderer.toneMapping, ToneMapping::Aces);
   // Extensions the listing leaves out take their defaults.
   EXPECT_EQ(s.renderer.exposure, 0.0f);
-  EXPECT_EQ(s.renderer.algorithm, "pathtrace");
+  EXPECT_EQ(s.renderer.algorithm, Algorithm::Pathtrace);
   EXPECT_EQ(s.renderer.seed, 0u);
   EXPECT_EQ(s.renderer.storage, GridStorage::Auto);
   EXPECT_EQ(s.background, (Vec3f{0, 0, 0}));
@@ -173,7 +173,7 @@ TEST(SceneDefaults, OptionalKeysTakeTheDocumentedDefaults) {
   EXPECT_TRUE(r.hdr);
   EXPECT_EQ(r.toneMapping, ToneMapping::Aces);
   EXPECT_EQ(r.exposure, 0.0f);
-  EXPECT_EQ(r.algorithm, "pathtrace");
+  EXPECT_EQ(r.algorithm, Algorithm::Pathtrace);
   EXPECT_EQ(r.seed, 0u);
   EXPECT_EQ(r.raymarch.steps, 60);
   EXPECT_EQ(r.raymarch.shadowSteps, 10);
@@ -216,7 +216,7 @@ TEST(SceneDefaults, ExtensionsAreRead) {
   EXPECT_FALSE(r.hdr);
   EXPECT_EQ(r.toneMapping, ToneMapping::Reinhard);
   EXPECT_EQ(r.exposure, -1.5f);
-  EXPECT_EQ(r.algorithm, "lobe");
+  EXPECT_EQ(r.algorithm, Algorithm::Lobe);
   EXPECT_EQ(r.seed, 4294967295u);
   EXPECT_EQ(r.raymarch.steps, 7);
   EXPECT_EQ(r.raymarch.shadowSteps, 3);
@@ -468,7 +468,7 @@ TEST(SceneOverrides, ReplaceCreateAndParseValues) {
   EXPECT_EQ(s.background, (Vec3f{1, 1, 1}));
   EXPECT_EQ(s.renderer.seed, 3u);
   EXPECT_EQ(s.renderer.lobe.lobePoints, 10);
-  EXPECT_EQ(s.renderer.algorithm, "lobe");
+  EXPECT_EQ(s.renderer.algorithm, Algorithm::Lobe);
   EXPECT_EQ(s.materials[1].density, 2.5f);
   EXPECT_EQ(s.renderer.toneMapping, ToneMapping::None);
   EXPECT_EQ(s.camera.position, (Vec3f{0, 0, -9}));

@@ -38,7 +38,7 @@ struct FakeRenderer {
       const float v = 0.5f + noise - 0.1f / float(1 + s.renderer.bounces);
       r.image.rgb.insert(r.image.rgb.end(), {v, v, v});
     }
-    r.stats.algorithm = s.renderer.algorithm;
+    r.stats.algorithm = algorithmName(s.renderer.algorithm);
     r.stats.device = "fake device";
     r.stats.spp = s.renderer.spp;
     r.stats.bounces = s.renderer.bounces;
