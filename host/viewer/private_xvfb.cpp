@@ -1,6 +1,7 @@
 #include "viewer/private_xvfb.h"
 
 #include <poll.h>
+#include <sys/prctl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -33,6 +34,8 @@ PrivateXvfb::PrivateXvfb(int width, int height) {
   pid_ = fork();
   if (pid_ == 0) {
     close(fds[0]);
+    // The server goes with the viewer even when the viewer cannot stop it (killed, Ctrl-C).
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
     // Its chatter (font paths, keyboard maps) is not the user's business.
     if (freopen("/dev/null", "w", stderr) == nullptr) _exit(127);
     execlp("Xvfb", "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", screen.c_str(), "-nolisten", "tcp",

@@ -1,6 +1,7 @@
 // private_xvfb.h: a virtual X server of the viewer's own, for headless runs (--script, --frames)
 // on a machine without a display: Xvfb started on a free display number (it reports the number
-// through -displayfd), DISPLAY pointed at it, and the server stopped when this object goes.
+// through -displayfd), DISPLAY pointed at it, and the server stopped when this object goes (or,
+// should the viewer be killed, by the kernel: PR_SET_PDEATHSIG).
 #pragma once
 
 #include <string>
