@@ -149,10 +149,6 @@ double RealtimeRenderer::renderFrame(bool progressiveCache, double* wallMs) {
   return eventSeconds(ev) * 1e3;
 }
 
-bool RealtimeRenderer::cacheComplete() const {
-  return params_.ms_cache.nx == 0 || msCache_.paths() >= view_.renderer.raymarch.msCache.paths;
-}
-
 RenderResult RealtimeRenderer::result() {
   RenderResult result;
   result.warnings = warnings_;

@@ -45,8 +45,6 @@ class RealtimeRenderer {
   double renderFrame(bool progressiveCache = false, double* wallMs = nullptr);
   // The last frame read back (image, status, caches' statistics); stats.frames stays empty.
   RenderResult result();
-  // Whether the multiple-scattering cache holds all the paths the scene asks for (true without it).
-  bool cacheComplete() const;
   const RenderStats& stats() const { return stats_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
   const DeviceScene& deviceScene() const { return dev_.scene; }

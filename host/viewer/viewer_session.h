@@ -71,10 +71,10 @@ class ViewerSession {
     double meanDeltaE76 = 0, jndPercent = 0;
   };
   const LiveError& liveError() const { return liveError_; }
-  // The scene the next full-size frame renders (camera, algorithm, quality, resolution).
-  Scene currentScene() const;
 
  private:
+  // The scene the next full-size frame renders (camera, algorithm, quality, resolution).
+  Scene currentScene() const;
   int chooseLevel() const;
   void writeSnapshot(const RenderResult& result, const Scene& view);
   void compose(const ImageRGB& image);
@@ -103,6 +103,8 @@ class ViewerSession {
   std::map<std::string, FrameTimes> frameTimes_;
   std::vector<std::string> messages_;
   LiveError liveError_;
+  std::vector<float> comparedRgb_;  // the last frame compared with the reference, and its error
+  LiveError comparedError_;
 };
 
 }  // namespace narval
