@@ -1,5 +1,5 @@
 // narval-native: the native baseline (issue 6, item 4). Loads a scene with the CLI's own host code
-// (loadScene with the same --set overrides, loadSceneGrid, buildDeviceScene), renders it with the
+// (loadScene with the same --set overrides, loadSceneGrids, buildDeviceScene), renders it with the
 // shared kernel headers compiled as C++ on N host threads (native_render.h), writes a 32-bit float
 // EXR and prints the timing as one JSON object on stdout. bench/native_baseline.sh runs it beside
 // `narval render` (PoCL) and reports the PoCL/native time ratio.
@@ -102,10 +102,13 @@ int run(const Args& a) {
   Scene scene = loadScene(a.scene, overridesFrom(a));
   for (const std::string& w : scene.warnings) std::cerr << "narval-native: warning: " << w << "\n";
   const std::string alg = algorithmName(scene.renderer.algorithm);
-  DenseGrid gridStorage;
-  const DenseGrid* grid = loadSceneGrid(scene, gridStorage);
+  SceneGridStorage gridStorage;
+  const SceneGrids grid = loadSceneGrids(scene, gridStorage);
   DeviceScene ds = buildDeviceScene(scene, grid);
   for (const std::string& w : ds.warnings) std::cerr << "narval-native: warning: " << w << "\n";
+  // The baseline compiles the shared headers without -DEMISSION: an emitting medium would render dark.
+  if (ds.params.medium.emission.kind != EMISSION_NONE)
+    throw InputError(a.scene + ": the native baseline renders no emission (the medium emits)");
   if (a.majorantResolution > 0) setMajorantResolution(ds, a.majorantResolution);
 
   native::NativeOptions o;

@@ -158,8 +158,8 @@ int runRender(const RenderArgs& a) {
                                                        algorithm);
 
   // Everything the render needs is loaded and checked before the first sample.
-  DenseGrid gridStorage;
-  const DenseGrid* g = loadSceneGrid(scene, gridStorage);
+  SceneGridStorage gridStorage;
+  const SceneGrids g = loadSceneGrids(scene, gridStorage);
   const InterruptWatch interrupt;  // from here on, Ctrl-C stops after the pass in flight
   ClRuntime rt(a.device);
 

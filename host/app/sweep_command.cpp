@@ -82,8 +82,8 @@ int runSweepCommand(const SweepArgs& a) {
   if (fs::exists(dir) && !fs::is_directory(dir))
     throw inputError("-o", "", "'" + a.out + "' exists and is not a folder");
 
-  DenseGrid gridStorage;
-  const DenseGrid* g = loadSceneGrid(scene, gridStorage);
+  SceneGridStorage gridStorage;
+  const SceneGrids g = loadSceneGrids(scene, gridStorage);
   ImageRGB reference;
   if (!a.reference.empty()) {
     reference = readExr(a.reference);

@@ -70,8 +70,8 @@ int runView(const ViewArgs& a) {
   options.render.localSizeY = ly;
 
   ViewerWindow window(scene.renderer.width, scene.renderer.height, "narval view: " + a.scene, run.frames > 0);
-  DenseGrid gridStorage;
-  const DenseGrid* grid = loadSceneGrid(scene, gridStorage);
+  SceneGridStorage gridStorage;
+  const SceneGrids grid = loadSceneGrids(scene, gridStorage);
   ClRuntime rt(a.device);
   ViewerSession session(rt, scene, grid, options);
   window.run(session, run);

@@ -9,7 +9,8 @@ namespace {
 // The arguments every narval kernel starts with (device_scene.h binds them): the scene, its lights,
 // the density grid (an image, a buffer, or an unused int for a homogeneous medium; grid.h's
 // GRID_PARAM) and the majorant grid's cells.
-const std::vector<std::string> kSceneArgs = {"scene", "lights", "grid", "grid_majorants"};
+const std::vector<std::string> kSceneArgs = {"scene", "lights", "grid", "grid_majorants", "emission_grid",
+                                             "emission_table"};
 
 std::vector<std::string> sceneArgsAnd(std::vector<std::string> more) {
   std::vector<std::string> all = kSceneArgs;

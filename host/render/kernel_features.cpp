@@ -35,6 +35,12 @@ std::string sceneFeatureOptions(const DeviceScene& ds) {
       default: throw unknownKind("phase function", sp.medium.phase);
     }
     add(sp.medium.grey ? "-DMEDIUM_GREY" : "-DMEDIUM_CHROMATIC");
+    switch (sp.medium.emission.kind) {
+      case EMISSION_NONE: break;
+      case EMISSION_COLOR:
+      case EMISSION_BLACKBODY: add("-DEMISSION"); break;
+      default: throw unknownKind("emission", sp.medium.emission.kind);
+    }
   }
   int rects = 0, points = 0;
   for (int i = 0; i < sp.num_lights && size_t(i) < ds.lights.size(); ++i)
@@ -56,8 +62,9 @@ std::string sceneBuildOptions(const DeviceScene& ds) {
   std::string o = (!sp.has_medium || !ds.grid) ? "-DMEDIUM_HOMOGENEOUS" : "";
   // Derived either way, so an unknown kind is an error on the host before anything is built.
   const std::string features = sceneFeatureOptions(ds);
-  if (kernelSpecialisationEnabled()) o = joinBuildOptions(o, features);
-  return o;
+  if (kernelSpecialisationEnabled()) return joinBuildOptions(o, features);
+  // The generic kernel carries every branch, emission's included (its kind then decides at run time).
+  return joinBuildOptions(o, "-DEMISSION");
 }
 
 std::string gridStorageBuildOption(GridStorage storage) {

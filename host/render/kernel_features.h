@@ -12,6 +12,8 @@
 //   -DLIGHTS_POINT_ONLY / -DLIGHTS_RECT_ONLY     no rectangle light / only rectangles (intersect.h,
 //                                                                                   light.h, march.h)
 //   -DCAMERA_PINHOLE                             lens_radius not positive            (camera.h)
+//   -DEMISSION                                   the medium emits; without it no kernel
+//                                                function carries emission code      (emission.h)
 //
 // Each is derived from the values the kernel would test at run time (DeviceScene.params and
 // .lights), so a specialised kernel takes the generic kernel's branch by construction and computes
@@ -21,7 +23,8 @@
 //
 // NARVAL_GENERIC=1 in the environment turns specialisation off (for measurement and debugging:
 // bench/specialisation.sh); it is read at every buildDeviceScene. MEDIUM_HOMOGENEOUS is not a
-// specialisation (the kernel's grid argument is an int then) and stays.
+// specialisation (the kernel's grid argument is an int then) and stays; the generic kernel is built
+// with -DEMISSION, whose code then tests the emission kind at run time.
 //
 // The driver's choices, after those:
 //   -DGRID_STORAGE_BUFFER / -DGRID_STORAGE_BRICKS  the grid as a buffer or bricks (image: none)
@@ -57,7 +60,7 @@ std::string sceneBuildOptions(const DeviceScene& ds);
 std::string gridStorageBuildOption(GridStorage storage);
 
 // The feature options of `ds`, space-separated in the order of the table above ("" for none).
-// Throws std::logic_error for a phase function or light kind the kernels do not know.
+// Throws std::logic_error for a phase function, light or emission kind the kernels do not know.
 std::string sceneFeatureOptions(const DeviceScene& ds);
 
 // False when NARVAL_GENERIC is set to anything but "" or "0".

@@ -25,7 +25,7 @@ int pathtraceSamplesPerPass(int width, int height, int spp) {
   return int(std::min<long long>(perPass, std::max(1, spp)));
 }
 
-PathtraceRenderer::PathtraceRenderer(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
+PathtraceRenderer::PathtraceRenderer(ClRuntime& rt, const Scene& scene, SceneGrids grid,
                                      const RenderOptions& options)
     : rt_(rt), view_(scene), options_(options), dev_(rt, scene, grid) {
   checkMajorantOptions(options);
@@ -151,7 +151,7 @@ void PathtraceRenderer::readBack(RenderResult& into) {
   }
 }
 
-RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
+RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, SceneGrids grid,
                              const RenderOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   PathtraceRenderer renderer(rt, scene, grid, options);

@@ -23,7 +23,7 @@ int pathtraceSamplesPerPass(int width, int height, int spp);
 class PathtraceRenderer {
  public:
   // Builds the program and uploads the scene; the accumulator starts from options.resumeFrom or 0.
-  PathtraceRenderer(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, const RenderOptions& options = {});
+  PathtraceRenderer(ClRuntime& rt, const Scene& scene, SceneGrids grid, const RenderOptions& options = {});
   // The scene with another camera or renderer.resolution (its medium, lights and settings unchanged):
   // the accumulator starts over from 0 samples.
   void setView(const Scene& view);
@@ -55,7 +55,7 @@ class PathtraceRenderer {
 };
 
 // Renders `scene` (already validated; `grid` is the volume's grid or null) on rt's device.
-RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
+RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, SceneGrids grid,
                              const RenderOptions& options = {});
 
 }  // namespace narval

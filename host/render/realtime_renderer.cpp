@@ -51,7 +51,7 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   return p;
 }
 
-RealtimeRenderer::RealtimeRenderer(ClRuntime& rt, const Scene& scene, const DenseGrid* grid,
+RealtimeRenderer::RealtimeRenderer(ClRuntime& rt, const Scene& scene, SceneGrids grid,
                                    const RenderOptions& options)
     : rt_(rt), view_(scene), options_(options), dev_(rt, checkedScene(scene, options), grid) {
   const std::string algorithm = algorithmName(scene.renderer.algorithm);
@@ -172,7 +172,7 @@ RenderResult RealtimeRenderer::result() {
   return result;
 }
 
-RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, int frames,
+RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, SceneGrids grid, int frames,
                             const RenderOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   RealtimeRenderer renderer(rt, scene, grid, options);

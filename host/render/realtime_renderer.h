@@ -34,7 +34,7 @@ class RealtimeRenderer {
  public:
   // scene.renderer.algorithm must be "raymarch" or "lobe". Builds the program and uploads the scene;
   // the caches are built by the first frame.
-  RealtimeRenderer(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, const RenderOptions& options = {});
+  RealtimeRenderer(ClRuntime& rt, const Scene& scene, SceneGrids grid, const RenderOptions& options = {});
   // The next frames show `view`: the constructor's scene with another camera, renderer.resolution or
   // renderer.raymarch / renderer.lobe settings (its medium, lights and algorithm unchanged).
   void setView(const Scene& view);
@@ -69,7 +69,7 @@ class RealtimeRenderer {
 
 // Renders scene.renderer.algorithm ("raymarch" or "lobe") `frames` times (>= 1); the image is the
 // last frame (every frame is the same: the kernels are deterministic).
-RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, int frames,
+RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, SceneGrids grid, int frames,
                             const RenderOptions& options = {});
 
 }  // namespace narval

@@ -11,6 +11,7 @@
 #include <glm/matrix.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "render/blackbody.h"
 #include "render/kernel_features.h"
 #include "scene/input_error.h"
 #include "volume/majorant_grid.h"
@@ -83,6 +84,66 @@ light_params buildLight(const Primitive& p, const Material& m) {
   return l;
 }
 
+// The file's index-to-world map of a loaded grid as an nv_affine.
+nv_affine gridIndexToFile(const DenseGrid& g) {
+  float f[3][4];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) f[r][c] = g.indexToWorld[size_t(r * 4 + c)];
+  return fromRows(f);
+}
+
+// medium.emission of volume material `materialIndex` (kernels/shared/emission.h) and, for blackbody
+// emission from a grid, ds.emissionTable. The emission grid is placed through the file: medium
+// index → the density grid's file space → the emission grid's index space, so a grid with another
+// transform or bounding box than the density's lands where the file puts it.
+void buildEmission(const Scene& scene, int materialIndex, const DenseGrid* density, const DenseGrid* emissionGrid,
+                   DeviceScene& ds) {
+  const Material& m = scene.materials.at(size_t(materialIndex));
+  const Emission& e = m.emission;
+  emission_params& ep = ds.params.medium.emission;
+  ep = emission_params{};
+  const std::string key = "materials[" + std::to_string(materialIndex) + "].emission";
+  const bool wantsGrid = !e.grid.empty();
+  if (wantsGrid && !emissionGrid)
+    throw inputError(scene.sourcePath, key, "the emission grid \"" + e.grid + "\" was not loaded");
+  if (wantsGrid) {
+    if (!density) throw inputError(scene.sourcePath, key, "an emission grid needs the volume's grid file");
+    ep.index_to_grid = affineMultiply(affineInverse(gridIndexToFile(*emissionGrid)), gridIndexToFile(*density));
+    ep.grid_dims = f4(float(emissionGrid->nx), float(emissionGrid->ny), float(emissionGrid->nz));
+    ds.emissionGrid = emissionGrid;
+  }
+  switch (e.kind) {
+    case EmissionKind::None: ep.kind = EMISSION_NONE; return;
+    case EmissionKind::Color:
+      ep.kind = EMISSION_COLOR;
+      ep.color = f4(e.color[0] * e.scale, e.color[1] * e.scale, e.color[2] * e.scale);
+      return;
+    case EmissionKind::Blackbody: break;  // below
+  }
+  if (!wantsGrid) {
+    // A constant temperature is a constant colour: B(T) once, here.
+    const std::array<float, 3> rgb = blackbodyLinearSrgb(e.temperature);
+    ep.kind = EMISSION_COLOR;
+    ep.color = f4(rgb[0] * e.scale, rgb[1] * e.scale, rgb[2] * e.scale);
+    return;
+  }
+  ep.kind = EMISSION_BLACKBODY;
+  ep.color = f4(e.scale, e.scale, e.scale);
+  ep.temperature_offset = e.temperatureOffset;
+  ep.temperature_scale = e.temperatureScale;
+  // The hottest the grid can give: T is linear in the value, so at one of its extremes (0, the
+  // loaders keep values >= 0, or maxValue). The table reaches a little past it.
+  const float hottest = std::max((0.0f - e.temperatureOffset) * e.temperatureScale,
+                                 (emissionGrid->maxValue - e.temperatureOffset) * e.temperatureScale);
+  ep.table_max = std::max(hottest, 200.0f) * 1.001f;
+  ep.table_size = kBlackbodyTableSize;
+  ds.emissionTable.resize(size_t(3) * kBlackbodyTableSize);
+  for (int i = 0; i < kBlackbodyTableSize; ++i) {
+    const std::array<float, 3> rgb = blackbodyLinearSrgb(ep.table_max * float(i) / float(kBlackbodyTableSize - 1));
+    for (int c = 0; c < 3; ++c) ds.emissionTable[size_t(3 * i + c)] = rgb[size_t(c)];
+  }
+}
+
 }  // namespace
 
 camera_params buildCamera(const Scene& scene) {
@@ -151,7 +212,8 @@ bool mediumWorldBounds(const DeviceScene& ds, float lo[3], float hi[3]) {
   return true;
 }
 
-DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
+DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids) {
+  const DenseGrid* grid = grids.density;
   DeviceScene ds;
   scene_params& sp = ds.params;
   sp.camera = buildCamera(scene);
@@ -213,6 +275,7 @@ DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
     } catch (const std::domain_error&) {
       throw inputError(scene.sourcePath, key, "the volume's transform is singular (a zero scale?)");
     }
+    buildEmission(scene, p.materialIndex, grid, grids.emission, ds);
     ds.grid = grid;
     if (grid) {
       const std::array<int, 3> cells = chooseMajorantResolution(grid->nx, grid->ny, grid->nz);
@@ -227,6 +290,7 @@ DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid) {
     sp.medium.majorant_grid.cells_x = sp.medium.majorant_grid.cells_y = sp.medium.majorant_grid.cells_z = 1;
     ds.majorants.assign(1, sp.has_medium ? 1.0f : 0.0f);
   }
+  if (ds.emissionTable.empty()) ds.emissionTable.assign(3, 0.0f);
   sp.num_lights = int(ds.lights.size());
   if (ds.lights.empty()) ds.lights.push_back(light_params{});  // a buffer may not be empty
   ds.buildOptions = sceneBuildOptions(ds);  // render/kernel_features.h

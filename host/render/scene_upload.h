@@ -11,10 +11,30 @@
 
 namespace narval {
 
+// The grids a scene's medium reads: its density grid and, for an emitting medium that names one,
+// its emission or temperature grid (the same object when both name one grid of the file: it is
+// uploaded once). Converts from the density grid alone, for scenes without an emission grid.
+struct SceneGrids {
+  const DenseGrid* density = nullptr;   // null: homogeneous medium or none
+  const DenseGrid* emission = nullptr;  // null: no emission grid
+  SceneGrids() = default;
+  SceneGrids(const DenseGrid* densityGrid, const DenseGrid* emissionGrid = nullptr)  // NOLINT: implicit
+      : density(densityGrid), emission(emissionGrid) {}
+};
+
+// Entries of the blackbody table an emitting medium's kernels read (kernels/shared/emission.h):
+// over [0, T_max] that is a step of T_max/4095 kelvin, 0.8 K for a fire's 3200 K, where linear
+// interpolation of the colour is within 5e-5 of it (tests/unit/emission_test.cpp measures it).
+constexpr int kBlackbodyTableSize = 4096;
+
 struct DeviceScene {
   scene_params params{};
   std::vector<light_params> lights;
   const DenseGrid* grid = nullptr;  // null: homogeneous medium or none
+  const DenseGrid* emissionGrid = nullptr;  // null: none (medium.emission.grid_dims.x = 0)
+  // The blackbody table (medium.emission.table_size rgb triples over [0, table_max] kelvin); one
+  // triple of zeros when the medium has no blackbody emission (a buffer may not be empty).
+  std::vector<float> emissionTable;
   // Per-cell density bounds of the majorant grid (medium.majorant_grid): one cell of 1 for a
   // homogeneous medium, one cell of 0 without a medium.
   std::vector<float> majorants;
@@ -39,9 +59,10 @@ camera_params buildCamera(const Scene& scene);
 // medium.world_to_index), e.g. for a viewer to frame it. False (lo, hi untouched) without a medium.
 bool mediumWorldBounds(const DeviceScene& ds, float lo[3], float hi[3]);
 
-// `grid` must be the volume's loaded grid (or null for a homogeneous medium / no volume).
-// Throws InputError for geometry the renderer cannot use (a singular volume transform).
-DeviceScene buildDeviceScene(const Scene& scene, const DenseGrid* grid);
+// `grids` must be the volume's loaded grids (density null for a homogeneous medium / no volume;
+// emission the grid its emission names, or null). Throws InputError for geometry the renderer
+// cannot use (a singular volume transform) and for an emission grid that is missing.
+DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids);
 
 // Rebuilds the majorant grid of `ds` (its cells and medium.majorant_grid) with about `target` cells
 // along the grid's longest axis (chooseMajorantResolution); target 0 keeps the automatic choice

@@ -23,6 +23,21 @@ enum class MaterialType { Emitter, Volume };
 enum class PhaseFunction { Isotropic, HenyeyGreenstein };
 enum class GridSpace { Unit, File };
 
+// A volume's emission (pbrt-v4's model, kernels/shared/emission.h): the medium emits σa(x)·Le(x)
+// per unit length, Le = color · scale · v(x) (Color: v from the grid `grid` of the volume's file,
+// or 1 without one) or scale · B((v(x) − temperatureOffset) · temperatureScale) (Blackbody: v from
+// the temperature grid `grid`, or the constant `temperature` in kelvin; B the blackbody colour of
+// render/blackbody.h, nothing at or below 100 K).
+enum class EmissionKind { None, Color, Blackbody };
+struct Emission {
+  EmissionKind kind = EmissionKind::None;
+  std::string grid;          // the emission or temperature grid's name in the volume's file; empty: none
+  Vec3f color{1, 1, 1};      // Color only
+  float scale = 1.0f;
+  float temperature = 0.0f;  // kelvin, Blackbody without a grid
+  float temperatureOffset = 0.0f, temperatureScale = 1.0f;  // Blackbody with a grid
+};
+
 struct Material {
   std::string name;
   MaterialType type = MaterialType::Emitter;
@@ -36,6 +51,7 @@ struct Material {
   std::string gridName = "density";
   float density = 1.0f;      // multiplier D
   GridSpace gridSpace = GridSpace::Unit;
+  Emission emission;
 };
 
 enum class PrimitiveType { Rectangle, Volume, Point };

@@ -19,6 +19,16 @@
 // |   volume: density       | number: multiplier D            |     | 1           | >= 0                       |
 // |   volume: grid          | string: grid name in the .vdb   |     | density     | non-empty                  |
 // |   volume: gridSpace     | unit, file                      |     | unit        |                            |
+// |   volume: emission      | object (pbrt-v4's emission:     |     | none        | grid or temperature, not   |
+// |                         | σa·Le per unit length)          |     |             | both                       |
+// |     .grid               | string: grid of the file, Le =  |     | none: 1     | needs path; a float grid   |
+// |                         | color·scale·grid                |     |             |                            |
+// |     .color              | vec3 (with grid or alone)       |     | [1, 1, 1]   | >= 0; not with temperature |
+// |     .temperature        | string: temperature grid, or    |     |             | grid: needs path;          |
+// |                         | number: kelvin; Le = scale·B(T) |     |             | number >= 0                |
+// |     .temperatureOffset  | number, T = (v - offset)·tscale |     | 0           | temperature grid only      |
+// |     .temperatureScale   | number                          |     | 1           | temperature grid only      |
+// |     .scale              | number                          |     | 1           | >= 0                       |
 // | primitives              | array of objects                | req |             | at most one volume         |
 // |   [i].name              | string                          |     | ""          |                            |
 // |   [i].type              | rectangle, volume, point        | req |             |                            |
@@ -220,6 +230,48 @@ void readHenyeyGreensteinG(ObjectReader& r, Material& m) {
     r.context().warn(key, "ignored by the isotropic phase function (use \"phaseFunction\": \"hg\")");
 }
 
+// The volume's `emission` object (scene.h Emission). `hasFile`: the volume reads a grid file, so
+// the emission may name grids of it.
+Emission readEmission(JsonContext& ctx, const json& value, const std::string& key, bool hasFile) {
+  ObjectReader r(ctx, value, key);
+  Emission e;
+  const json* grid = r.find("grid");
+  const json* temperature = r.find("temperature");
+  if (grid && temperature)
+    ctx.fail(r.keyOf("temperature"), "give either \"grid\" (Le = color · scale · grid) or \"temperature\" "
+                                     "(blackbody), not both");
+  auto gridName = [&](const json& v, const std::string& name) {
+    const std::string g = toString(ctx, v, r.keyOf(name));
+    if (g.empty()) ctx.fail(r.keyOf(name), "must not be empty");
+    if (!hasFile) ctx.fail(r.keyOf(name), "names a grid, but the volume has no grid file (\"path\")");
+    return g;
+  };
+  if (temperature) {
+    e.kind = EmissionKind::Blackbody;
+    if (temperature->is_string()) {
+      e.grid = gridName(*temperature, "temperature");
+      e.temperatureOffset = r.getFloat("temperatureOffset", e.temperatureOffset);
+      e.temperatureScale = r.getFloat("temperatureScale", e.temperatureScale);
+    } else {
+      e.temperature = toFloat(ctx, *temperature, r.keyOf("temperature"));
+      checkNonNegative(ctx, r.keyOf("temperature"), e.temperature);
+      for (const char* k : {"temperatureOffset", "temperatureScale"})
+        if (r.has(k)) ctx.fail(r.keyOf(k), "applies to a temperature grid; \"temperature\" is a number here");
+    }
+    if (r.has("color")) ctx.fail(r.keyOf("color"), "does not apply to blackbody emission (\"temperature\")");
+  } else {
+    e.kind = EmissionKind::Color;
+    if (grid) e.grid = gridName(*grid, "grid");
+    e.color = r.getVec3("color", e.color);
+    checkNonNegative(ctx, r.keyOf("color"), e.color);
+    for (const char* k : {"temperatureOffset", "temperatureScale"})
+      if (r.has(k)) ctx.fail(r.keyOf(k), "applies to blackbody emission only (give \"temperature\")");
+  }
+  e.scale = readNonNegative(r, "scale", e.scale);
+  r.reportUnknown();
+  return e;
+}
+
 Material readMaterial(JsonContext& ctx, const json& value, const std::string& key) {
   ObjectReader r(ctx, value, key);
   Material m;
@@ -242,6 +294,7 @@ Material readMaterial(JsonContext& ctx, const json& value, const std::string& ke
     m.gridName = r.getString("grid", m.gridName);
     if (m.gridName.empty()) ctx.fail(r.keyOf("grid"), "must not be empty");
     m.gridSpace = readEnum(r, "gridSpace", kGridSpaces, m.gridSpace);
+    if (const json* e = r.find("emission")) m.emission = readEmission(ctx, *e, r.keyOf("emission"), !m.path.empty());
   }
   r.reportUnknown();
   return m;
@@ -448,10 +501,12 @@ void readPrimitives(JsonContext& ctx, ObjectReader& root, Scene& scene) {
 
 // Nothing emits: every pixel would be black, which users mistake for a renderer bug.
 void warnIfDark(const JsonContext& ctx, const Scene& scene) {
-  for (const Primitive& p : scene.primitives)
+  for (const Primitive& p : scene.primitives) {
     if (p.type != PrimitiveType::Volume) return;
+    if (scene.materials.at(size_t(p.materialIndex)).emission.kind != EmissionKind::None) return;  // it glows
+  }
   if (scene.background != Vec3f{0, 0, 0}) return;
-  ctx.warn("", "no light and a black background: the image will be black");
+  ctx.warn("", "no light, no emission and a black background: the image will be black");
 }
 
 std::string parseMessage(const json::exception& e) {

@@ -51,7 +51,7 @@ bool samePose(const Camera& a, const Camera& b) {
 
 }  // namespace
 
-ViewerSession::ViewerSession(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, const ViewerOptions& options)
+ViewerSession::ViewerSession(ClRuntime& rt, const Scene& scene, SceneGrids grid, const ViewerOptions& options)
     : rt_(rt),
       scene_(scene),
       grid_(grid),

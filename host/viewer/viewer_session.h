@@ -35,7 +35,7 @@ struct ViewerOptions {
 class ViewerSession {
  public:
   // `scene` is validated, its algorithm the first one shown; `grid` outlives the session.
-  ViewerSession(ClRuntime& rt, const Scene& scene, const DenseGrid* grid, const ViewerOptions& options);
+  ViewerSession(ClRuntime& rt, const Scene& scene, SceneGrids grid, const ViewerOptions& options);
   ~ViewerSession();
 
   // Applies one input; camera moves and settings take effect at the next frame. Frames inputs are
@@ -83,7 +83,7 @@ class ViewerSession {
 
   ClRuntime& rt_;
   Scene scene_;  // as loaded; the current camera, algorithm and quality are kept apart
-  const DenseGrid* grid_;
+  SceneGrids grid_;
   ViewerOptions options_;
   OrbitCamera camera_;
   Algorithm algorithm_;

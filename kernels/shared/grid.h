@@ -163,46 +163,53 @@ static inline float grid_bricks_trilinear(NV_GLOBAL const uint* table, NV_GLOBAL
 
 #ifdef NV_DEVICE
 
+/* GRID_STORAGE is the type of one grid in the chosen storage, grid_value(g, p) its trilinear value
+ * at index-space point p: the density grid and the emission grid (emission.h) share both. */
 #ifdef MEDIUM_HOMOGENEOUS
-#define GRID_PARAM int grid, NV_GLOBAL const float* grid_majorants /* grid: unused, an int */
-#define GRID_ARG grid, grid_majorants
-#define GRID_KERNEL_PARAM GRID_PARAM
-#define GRID_MAJORANTS grid_majorants
+#define GRID_STORAGE int /* unused */
 #define GRID_IS_HOMOGENEOUS(g) 1
-static inline float grid_density(GRID_PARAM, vec3 p) { return 1.0f; }
+static inline float grid_value(GRID_STORAGE g, vec3 p) { return 1.0f; }
 #elif defined(GRID_STORAGE_BRICKS)
-#define GRID_PARAM NV_GLOBAL const float* grid, NV_GLOBAL const float* grid_majorants
-#define GRID_ARG grid, grid_majorants
-#define GRID_KERNEL_PARAM GRID_PARAM
-#define GRID_MAJORANTS grid_majorants
+#define GRID_STORAGE NV_GLOBAL const float*
 #define GRID_IS_HOMOGENEOUS(g) 0
-static inline float grid_density(GRID_PARAM, vec3 p) {
-  const int4 h = vload4(0, (NV_GLOBAL const int*)grid);
-  return grid_bricks_trilinear((NV_GLOBAL const uint*)grid + GRID_BRICKS_HEADER, grid + h.w, h.x, h.y, h.z, p);
+static inline float grid_value(GRID_STORAGE g, vec3 p) {
+  const int4 h = vload4(0, (NV_GLOBAL const int*)g);
+  return grid_bricks_trilinear((NV_GLOBAL const uint*)g + GRID_BRICKS_HEADER, g + h.w, h.x, h.y, h.z, p);
 }
 #elif defined(GRID_STORAGE_BUFFER)
-#define GRID_PARAM NV_GLOBAL const float* grid, NV_GLOBAL const float* grid_majorants
-#define GRID_ARG grid, grid_majorants
-#define GRID_KERNEL_PARAM GRID_PARAM
-#define GRID_MAJORANTS grid_majorants
+#define GRID_STORAGE NV_GLOBAL const float*
 #define GRID_IS_HOMOGENEOUS(g) 0
-static inline float grid_density(GRID_PARAM, vec3 p) {
-  const int4 h = vload4(0, (NV_GLOBAL const int*)grid);
-  return grid_trilinear(grid + GRID_BUFFER_HEADER, h.x, h.y, h.z, p);
+static inline float grid_value(GRID_STORAGE g, vec3 p) {
+  const int4 h = vload4(0, (NV_GLOBAL const int*)g);
+  return grid_trilinear(g + GRID_BUFFER_HEADER, h.x, h.y, h.z, p);
 }
 #else
-#define GRID_PARAM read_only image3d_t grid, NV_GLOBAL const float* grid_majorants
-#define GRID_ARG grid, grid_majorants
-#define GRID_KERNEL_PARAM GRID_PARAM
-#define GRID_MAJORANTS grid_majorants
+#define GRID_STORAGE read_only image3d_t
 #define GRID_IS_HOMOGENEOUS(g) 0
 __constant sampler_t grid_sampler = CLK_NORMALIZED_COORDS_FALSE | CLK_ADDRESS_CLAMP | CLK_FILTER_LINEAR;
-static inline float grid_density(GRID_PARAM, vec3 p) {
+static inline float grid_value(GRID_STORAGE g, vec3 p) {
   /* Callers stay inside the box; the clamp keeps wild coordinates off the far edge (DESIGN.md). */
   const float4 q = (float4)(clamp(p.x, -1.0f, 1.0e7f), clamp(p.y, -1.0f, 1.0e7f), clamp(p.z, -1.0f, 1.0e7f), 0.0f);
-  return read_imagef(grid, grid_sampler, q).x;
+  return read_imagef(g, grid_sampler, q).x;
 }
 #endif
+
+/* Every kernel takes the density grid, the majorant cells, the emission grid and the blackbody
+ * table (GRID_KERNEL_PARAM: the host binds the same list for every build, cl/kernel_args.h); the
+ * functions below the entry carry the emission pair only in an -DEMISSION build, so a scene without
+ * emission compiles no emission code at all. */
+#ifdef EMISSION
+#define GRID_PARAM GRID_STORAGE grid, NV_GLOBAL const float* grid_majorants, GRID_STORAGE emission_grid, \
+                   NV_GLOBAL const float* emission_table
+#define GRID_ARG grid, grid_majorants, emission_grid, emission_table
+#define GRID_KERNEL_PARAM GRID_PARAM
+#else
+#define GRID_PARAM GRID_STORAGE grid, NV_GLOBAL const float* grid_majorants
+#define GRID_ARG grid, grid_majorants
+#define GRID_KERNEL_PARAM GRID_PARAM, GRID_STORAGE emission_grid, NV_GLOBAL const float* emission_table
+#endif
+#define GRID_MAJORANTS grid_majorants
+static inline float grid_density(GRID_PARAM, vec3 p) { return grid_value(grid, p); }
 
 #else /* host */
 
@@ -210,6 +217,11 @@ typedef struct grid_view {
   const float* data; /* NULL: homogeneous, density 1 */
   int nx, ny, nz;
   const float* majorants; /* per-cell density bounds (medium_params.majorant_grid); NULL: no skipping */
+  /* Emission (emission.h, read with -DEMISSION): the emission grid (NULL: none) and the blackbody
+   * table (medium_params.emission). */
+  const float* emission_data;
+  int emission_nx, emission_ny, emission_nz;
+  const float* emission_table;
 } grid_view;
 #define GRID_PARAM const grid_view* grid
 #define GRID_ARG grid

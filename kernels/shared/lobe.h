@@ -92,6 +92,9 @@
  * Result: L = L_b·T_v + (1 − T_v)·albedo ⊙ (1/n) Σ_i Σ_k p(cos θ_i) · Tr(P_i → light_k) · I_k / d².
  * Loops: one march of view_steps, n × lights lookups; no first-hit search, no view marches.
  *
+ * Emission (-DEMISSION, emission.h): both variants add march_emission over the view ray's segment,
+ * the medium's own light, which neither estimate above holds.
+ *
  * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density, phase value or
  * lobe point met on the way; STATUS_ITERATION_CAP from a DDA walk. No pdf: never
  * STATUS_NEGATIVE_PDF. */
@@ -316,10 +319,18 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
   /* 3. Frame (t, b, ω) from the camera's right vector; (t, b, ω) is right-handed. */
   const vec3 tx = vec3_normalize(vec3_madd(right, dir, -vec3_dot(right, dir)));
   const vec3 ty = vec3_cross(dir, tx);
-  if (p->lobe_variant == LOBE_CORRECTED)
-    return lobe_radiance_corrected(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status);
-  /* LOBE_EQ7, the only other variant the host writes (scene_load.cpp). */
-  return lobe_radiance_eq7(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status);
+  const int corrected = p->lobe_variant == LOBE_CORRECTED; /* else LOBE_EQ7, the host's only other variant */
+  const vec3 L = corrected
+                     ? lobe_radiance_corrected(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status)
+                     : lobe_radiance_eq7(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status);
+#ifdef EMISSION
+  /* The medium's own light, marched with the variant's view-ray samples (eq7: its first-hit search's
+   * `steps`; corrected: its view march's view_steps). */
+  return vec3_add(L, march_emission(&s->medium, GRID_ARG, &seg, corrected ? p->view_steps : p->steps,
+                                    p->min_transmittance, status));
+#else
+  return L;
+#endif
 }
 
 /* The pixel (px, py): ray through its centre (deterministic, no jitter). Non-finite results are

@@ -6,7 +6,11 @@
  * Status word: STATUS_NAN for a non-finite sample (written as 0) or a NaN met on the way (density,
  * majorant, phase value: tracking.h and below); STATUS_NEGATIVE_PDF for a phase-sampled direction
  * whose pdf is not positive and for a majorant below σt (tracking.h); STATUS_ITERATION_CAP from the
- * tracking walks' cap (tracking.h). Majorant (grid or global) and counters (-DCOUNTERS): tracking.h. */
+ * tracking walks' cap (tracking.h). Majorant (grid or global) and counters (-DCOUNTERS): tracking.h.
+ * Emissive media (-DEMISSION): the free-flight walk of every segment adds the medium's own light
+ * to L (tracking.h, pbrt-v4's estimator), the camera's segment and every one after a scattering
+ * event alike: emission seen after k scattering events is light of k bounces, as an emitter or the
+ * background the path reaches. */
 #ifndef NARVAL_PATHTRACE_H
 #define NARVAL_PATHTRACE_H
 
@@ -78,7 +82,8 @@ static inline vec3 pathtrace_radiance(NV_CONSTANT const scene_params* s, NV_CONS
     medium_segment seg;
     if (s->has_medium && medium_intersect(&s->medium, o, d, 0.0f, t_surf, &seg)) {
       float t_hit;
-      const int event = tracking_delta(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit, status TRACK_COUNTERS_ARG);
+      const int event = tracking_delta(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit,
+                                       status TRACK_EMISSION_ARG(&L) TRACK_COUNTERS_ARG);
       if (event == TRACK_ABSORBED) break;
       if (event == TRACK_SCATTERED) {
         if (depth >= s->max_bounces) break;

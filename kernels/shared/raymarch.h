@@ -46,6 +46,10 @@
  * does not hold (scattered at least once, and the background), by its directional average R and
  * first moment b, inside the same energy-conserving step.
  *
+ * Emission (-DEMISSION, emission.h): S_k gains σa(x_k) ⊙ Le(x_k), the medium's own light, inside
+ * the same energy-conserving step (an absorbing, emitting homogeneous slab: Le·(1 − e^{−σa·d})).
+ * The early-termination bound below then takes A ≥ max Le as well.
+ *
  * Early termination (min_transmittance = ε > 0; 0 never stops): the march stops after the step
  * where every channel of T fell below ε' = ε / max(1, max channel of L_b), and the pixel is L + T·L_b
  * with the T reached. Error bound, per channel: what the rest of the march would have added is
@@ -73,20 +77,6 @@
 #include "shared/light_cache.h"
 #include "shared/ms_cache.h"
 #include "shared/phase.h"
-
-/* Below this optical depth per step, (1 − e^{−x})/x is evaluated by its Taylor series: the direct
- * form loses |rounding of e^{−x}|/x to cancellation (≤ 3 ulp·2⁻²³/x ≈ 4e-6 relative at x = 0.1,
- * less above), the series 1 − x/2 + x²/6 − x³/24 + x⁴/120 is off by ≤ x⁵/720 ≈ 1.4e-8 below it, and
- * at x = 0 (σt = 0) it is exactly 1, so the step integral is exactly S·Δ, never 0/0. */
-#define RAYMARCH_SERIES_MAX 0.1f
-
-/* (1 − e^{−x})/x for x ≥ 0, given e = e^{−x}: the energy-conserving step integral
- * (S − S·e^{−σtΔ})/σt = S·Δ·raymarch_step_weight(σtΔ). */
-static inline float raymarch_step_weight(float x, float e) {
-  if (x < RAYMARCH_SERIES_MAX)
-    return 1.0f - x * (0.5f - x * (1.0f / 6.0f - x * (1.0f / 24.0f - x * (1.0f / 120.0f))));
-  return (1.0f - e) / x;
-}
 
 /* Light arriving at x and scattered towards the camera, per unit σs: Σ_lights (I/d²) ⊙
  * Σ_{i<N} aⁱ p(g cⁱ, μ) exp(−bⁱ τ). view_dir points away from the camera. */
@@ -172,12 +162,10 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
                                           phase_mean_cosine(m->phase, m->g), vec3_scale(dir, -1.0f)));
       S = vec3_mul(sigma_s, Li);
     }
-    const vec3 x = vec3_scale(sigma_t, dt);
-    const vec3 e = vec3_exp_neg(x);
-    const vec3 w = vec3_make(raymarch_step_weight(x.x, e.x), raymarch_step_weight(x.y, e.y),
-                             raymarch_step_weight(x.z, e.z));
-    acc->L = vec3_add(acc->L, vec3_mul(acc->T, vec3_scale(vec3_mul(S, w), dt)));
-    acc->T = vec3_mul(acc->T, e);
+#ifdef EMISSION
+    S = vec3_add(S, emission_source(m, GRID_ARG, vec3_madd(seg->o, seg->d, t), rho)); /* σa·Le (emission.h) */
+#endif
+    march_energy_conserving_step(&acc->L, &acc->T, S, sigma_t, dt);
     if (vec3_max_component(acc->T) < t_stop) break; /* early termination (above) */
   }
   *status |= it.status;

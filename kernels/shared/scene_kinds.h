@@ -1,5 +1,5 @@
 /* scene_kinds.h: every kind the kernels dispatch on by switch, checked once at each kernel's entry.
- * The switches (phase.h, light.h, march.h) give an unknown kind no contribution; this check makes it
+ * The switches (phase.h, light.h, march.h, emission.h) give an unknown kind no contribution; this check makes it
  * visible: STATUS_UNKNOWN_KIND in the status word, which the host reports. The host validates kinds
  * before it uploads a scene (render/kernel_features.h), so the bit means host and kernels out of
  * step, never bad input. */
@@ -14,6 +14,16 @@ static inline uint scene_kinds_status(NV_CONSTANT const scene_params* s, NV_CONS
     switch (s->medium.phase) {
       case PHASE_ISOTROPIC:
       case PHASE_HG: break;
+      default: status |= STATUS_UNKNOWN_KIND;
+    }
+    switch (s->medium.emission.kind) {
+      case EMISSION_NONE: break;
+      case EMISSION_COLOR:
+      case EMISSION_BLACKBODY:
+#ifndef EMISSION
+        status |= STATUS_UNKNOWN_KIND; /* an emitting medium in a kernel built without emission */
+#endif
+        break;
       default: status |= STATUS_UNKNOWN_KIND;
     }
   }

@@ -64,6 +64,27 @@ typedef struct majorant_grid_params {
   int pad0;
 } majorant_grid_params;
 
+/* Emission kinds (emission_params.kind; kernels/shared/emission.h). */
+#define EMISSION_NONE 0
+#define EMISSION_COLOR 1     /* Le = color · v: v the emission grid's value, or 1 without a grid */
+#define EMISSION_BLACKBODY 2 /* Le = color · B((v − temperature_offset) · temperature_scale) */
+
+/* Emission of the medium (pbrt-v4's model: σa(x)·Le(x) per unit length). The emission grid has an
+ * index space of its own (its own transform and bounding box in the file); index_to_grid maps the
+ * medium's index space into it. B is the blackbody table (host/render/blackbody.h): table_size
+ * linear-sRGB entries over [0, table_max] kelvin, evenly spaced, 0 at or below 100 K. */
+typedef struct emission_params {
+  nv_affine index_to_grid; /* medium index space → emission grid index space */
+  nv_float4 grid_dims;     /* the emission grid's resolution; x = 0: no grid (v = 1) */
+  nv_float4 color;         /* colour · scale (EMISSION_COLOR), scale in each channel (EMISSION_BLACKBODY) */
+  float temperature_offset;
+  float temperature_scale;
+  float table_max;         /* kelvin of the table's last entry */
+  int table_size;          /* entries (rgb triples) in the table */
+  int kind;                /* EMISSION_NONE, EMISSION_COLOR or EMISSION_BLACKBODY */
+  int pad0, pad1, pad2;
+} emission_params;
+
 /* The participating medium: an axis-aligned box [0, dims] in grid index space (voxel i covers
  * [i, i+1], its centre at i + 0.5), reached from world space through one affine map. Coefficients
  * are per unit density and already include the material's density multiplier D. */
@@ -77,6 +98,7 @@ typedef struct medium_params {
   int phase;            /* PHASE_ISOTROPIC or PHASE_HG */
   int grey;             /* 1: sigma_a and sigma_s are equal in all channels (analogue tracking) */
   majorant_grid_params majorant_grid; /* density bounds per cell: empty space is skipped */
+  emission_params emission;
 } medium_params;
 
 /* A grid of nodes spanning the medium's index box corner to corner (kernels/shared/node_grid.h):

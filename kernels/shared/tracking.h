@@ -12,6 +12,7 @@
 #ifndef NARVAL_TRACKING_H
 #define NARVAL_TRACKING_H
 
+#include "shared/emission.h"
 #include "shared/grid.h"
 #include "shared/majorant.h"
 #include "shared/rng.h"
@@ -121,6 +122,23 @@ typedef struct track_counters {
 #define TRACK_COUNT(field) ((void)0)
 #endif
 
+/* Emission (-DEMISSION, emission.h): tracking_delta also collects the medium's own light into
+ * *emitted, pbrt-v4's estimator: at every tentative collision t_i (null or real, before its event
+ * is chosen) it adds β ⊙ σa(t_i)·Le(t_i)/σ̄(t_i), β the throughput there. Unbiased: tentative
+ * collisions that the walk reaches without a real event before them arrive with density
+ * σ̄(t)·T(t) (thinning of the Poisson process of rate σ̄; with spectral tracking β carries each
+ * channel's T(t)/(the walk's own survival)), so the expected sum is ∫ T(t) σa(t) Le(t) dt, the
+ * emission term of the segment up to its end, for any majorant (grid or global). A real collision
+ * ends the segment: the emission beyond it belongs to the paths that scatter there. Without
+ * EMISSION the parameter and the lookups vanish. */
+#ifdef EMISSION
+#define TRACK_EMISSION_PARAM , NV_PRIVATE vec3* emitted
+#define TRACK_EMISSION_ARG(x) , x
+#else
+#define TRACK_EMISSION_PARAM
+#define TRACK_EMISSION_ARG(x)
+#endif
+
 /* The walk's position in its majorant segments. */
 typedef struct tracking_walk {
   majorant_iter dda;  /* grid: the cells still ahead */
@@ -184,7 +202,8 @@ static inline int tracking_walk_step(NV_PRIVATE tracking_walk* w, NV_GLOBAL cons
  * is the collision and *beta has been reweighted (chromatic media only). */
 static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 o, vec3 d, float t,
                                  float t_max, NV_PRIVATE rng_state* rng, NV_PRIVATE vec3* beta,
-                                 NV_PRIVATE float* t_out, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+                                 NV_PRIVATE float* t_out, NV_PRIVATE uint* status TRACK_EMISSION_PARAM
+                                 TRACK_COUNTERS_PARAM) {
   if (!(m->majorant < NV_INFINITY)) { /* NaN or +inf */
     *status |= STATUS_NAN;
     return TRACK_ABSORBED;
@@ -199,7 +218,13 @@ static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM,
     const float sigma_bar = w.bar;
     TRACK_COUNT(tentative);
     TRACK_COUNT(lookups);
-    const float rho = grid_density(GRID_ARG, vec3_madd(o, d, w.t));
+    const vec3 x_index = vec3_madd(o, d, w.t);
+    const float rho = grid_density(GRID_ARG, x_index);
+#ifdef EMISSION
+    if (rho > 0.0f) /* β ⊙ σa·Le/σ̄ at every tentative collision (above) */
+      *emitted = vec3_add(*emitted, vec3_scale(vec3_mul(*beta, emission_source(m, GRID_ARG, x_index, rho)),
+                                               1.0f / sigma_bar));
+#endif
     const float u = rng_uniform(rng);
     if (grey) {
       const float pa = sa.x * rho / sigma_bar, ps = ss.x * rho / sigma_bar;

@@ -3,7 +3,7 @@
  * otherwise the 3D image and its sampler). */
 #include "shared/grid.h"
 
-__kernel void grid_lookup(GRID_KERNEL_PARAM, __global const float4* points, __global float* out) {
+__kernel void grid_lookup(GRID_PARAM, __global const float4* points, __global float* out) {
   const int i = get_global_id(0);
   const float4 q = points[i];
   out[i] = grid_density(GRID_ARG, vec3_make(q.x, q.y, q.z));

@@ -1,7 +1,7 @@
 // The host binds kernel arguments by the names listed in cl/kernel_args.cpp; each list must be the
 // kernel's own signature. Every kernel is built from source with -cl-kernel-arg-info in each build
 // variant that changes its signature (the grid as an unused int, a buffer or an image; the path
-// tracer's counters), and the device's names (clGetKernelArgInfo) must equal the list, in order.
+// tracer's counters; emission), and the device's names (clGetKernelArgInfo) must equal the list, in order.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -37,7 +37,9 @@ TEST(KernelArgs, EveryListIsItsKernelsSignatureInEveryVariant) {
   for (const std::string& kernel : kernels) {
     std::vector<std::string> listed = kernelArgumentNames(kernel);
     // Bricks take the buffer's signature (grid.h): the three kinds of grid argument are these.
-    for (const char* variant : {"-DMEDIUM_HOMOGENEOUS", "-DGRID_STORAGE_BUFFER", ""}) {
+    // With and without -DEMISSION: the emission grid and table are arguments of every build.
+    for (const char* variant : {"-DMEDIUM_HOMOGENEOUS", "-DGRID_STORAGE_BUFFER", "", "-DMEDIUM_HOMOGENEOUS -DEMISSION",
+                                "-DGRID_STORAGE_BUFFER -DEMISSION", "-DEMISSION"}) {
       SCOPED_TRACE(kernel + " " + variant);
       std::vector<std::string> expected = listed;
       if (kernel == "pathtrace") {
@@ -60,7 +62,7 @@ TEST(KernelArgs, AnUnknownNameIsAnErrorNamingTheArguments) {
   } catch (const std::logic_error& e) {
     EXPECT_STREQ(e.what(),
                  "kernel 'light_cache_build' has no argument 'status' (its arguments: scene, lights, grid, "
-                 "grid_majorants, params, light, cache, status_word)");
+                 "grid_majorants, emission_grid, emission_table, params, light, cache, status_word)");
   }
   EXPECT_THROW(kernelArgumentNames("volume_march"), std::logic_error);
 }

@@ -3,7 +3,7 @@
 #include "shared/medium.h"
 #include "shared/tracking.h"
 
-__kernel void ratio_tracking_stats(__constant medium_params* m, GRID_KERNEL_PARAM, __global const float4* rays,
+__kernel void ratio_tracking_stats(__constant medium_params* m, GRID_PARAM, __global const float4* rays,
                                    uint n, __global float* out_mean, __global float* out_var,
                                    __global uint* status_word) {
   const int i = get_global_id(0);
@@ -31,7 +31,7 @@ __kernel void ratio_tracking_stats(__constant medium_params* m, GRID_KERNEL_PARA
 
 /* Delta tracking on the same rays: the fraction of n walks (absorption-only view: any real
  * collision ends the walk) that escape the box, the free-flight estimate of the transmittance. */
-__kernel void delta_escape_fraction(__constant medium_params* m, GRID_KERNEL_PARAM, __global const float4* rays,
+__kernel void delta_escape_fraction(__constant medium_params* m, GRID_PARAM, __global const float4* rays,
                                     uint n, __global float* out_fraction, __global uint* status_word) {
   const int i = get_global_id(0);
   const vec3 o = rays[2 * i].xyz;

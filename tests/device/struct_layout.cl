@@ -25,6 +25,11 @@
   F(medium_params, dims) F(medium_params, sigma_a) F(medium_params, sigma_s)                       \
   F(medium_params, majorant) F(medium_params, g) F(medium_params, phase) F(medium_params, grey)    \
   F(medium_params, majorant_grid) F(medium_params, majorant_grid.cells_z)                         \
+  F(medium_params, emission) F(medium_params, emission.kind)                                       \
+  S(emission_params) F(emission_params, index_to_grid) F(emission_params, grid_dims)              \
+  F(emission_params, color) F(emission_params, temperature_offset)                                \
+  F(emission_params, temperature_scale) F(emission_params, table_max) F(emission_params, table_size)\
+  F(emission_params, kind) F(emission_params, pad0) F(emission_params, pad1) F(emission_params, pad2)\
   S(majorant_grid_params) F(majorant_grid_params, cell_size) F(majorant_grid_params, cells_x)     \
   F(majorant_grid_params, cells_y) F(majorant_grid_params, cells_z) F(majorant_grid_params, pad0)  \
   S(scene_params) F(scene_params, camera) F(scene_params, camera.height) F(scene_params, medium)    \

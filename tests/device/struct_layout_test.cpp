@@ -49,7 +49,7 @@ TEST(StructLayoutHost, SizesAreMultiplesOf16) {
     ++structs;
     EXPECT_EQ(v.value % 16u, 0u) << v.what << " = " << v.value;
   }
-  EXPECT_EQ(structs, 9);  // nv_float4, nv_affine, camera, light, medium, majorant grid, scene, node grid, realtime
+  EXPECT_EQ(structs, 10);  // nv_float4, nv_affine, camera, light, medium, emission, majorant grid, scene, node grid, realtime
   EXPECT_EQ(sizeof(nv_float4), 16u);
   EXPECT_EQ(sizeof(nv_affine), 48u);
   EXPECT_EQ(sizeof(camera_params), 96u);
@@ -57,8 +57,9 @@ TEST(StructLayoutHost, SizesAreMultiplesOf16) {
   EXPECT_EQ(sizeof(node_grid_params), 64u);
   EXPECT_EQ(sizeof(realtime_params), 192u);
   EXPECT_EQ(sizeof(majorant_grid_params), 32u);
-  EXPECT_EQ(sizeof(medium_params), 144u);
-  EXPECT_EQ(sizeof(scene_params), 272u);
+  EXPECT_EQ(sizeof(emission_params), 112u);
+  EXPECT_EQ(sizeof(medium_params), 256u);
+  EXPECT_EQ(sizeof(scene_params), 384u);
 }
 
 TEST(StructLayoutOnDevice, MatchesTheHost) {

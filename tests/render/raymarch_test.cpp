@@ -465,12 +465,12 @@ TEST(RenderRaymarch, NonFiniteRadianceRaisesStatusAndWritesZero) {
 // Host side (the header is plain C compiled here too): the step weight (1 − e^{−x})/x is exactly 1
 // at x = 0 (σt = 0 gives S·Δ, not 0/0) and continuous where the series hands over to the direct form.
 TEST(RenderRaymarch, HostStepWeight) {
-  EXPECT_EQ(raymarch_step_weight(0.0f, 1.0f), 1.0f);
+  EXPECT_EQ(march_step_weight(0.0f, 1.0f), 1.0f);
   for (float x : {1e-30f, 1e-8f, 1e-3f, 0.05f, 0.0999f, 0.1f, 0.5f, 3.0f, 80.0f}) {
     const double exact = -std::expm1(-double(x)) / x;
-    EXPECT_NEAR(raymarch_step_weight(x, std::exp(-x)), exact, 2e-6 * exact) << x;
+    EXPECT_NEAR(march_step_weight(x, std::exp(-x)), exact, 2e-6 * exact) << x;
   }
-  EXPECT_EQ(raymarch_step_weight(INFINITY, 0.0f), 0.0f);
+  EXPECT_EQ(march_step_weight(INFINITY, 0.0f), 0.0f);
 }
 
 }  // namespace

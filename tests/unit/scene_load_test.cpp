@@ -434,7 +434,7 @@ TEST(SceneWarnings, NoLightAndBlackBackground) {
   json j = minimalScene();
   j["primitives"].erase(0);
   EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
-            (std::vector<std::string>{"s.json: no light and a black background: the image will be black"}));
+            (std::vector<std::string>{"s.json: no light, no emission and a black background: the image will be black"}));
   j["background"] = {0.1, 0.1, 0.1};
   EXPECT_TRUE(parseScene(j.dump(), "s.json").warnings.empty());
 }

@@ -1,0 +1,81 @@
+/* emission.h: emissive media, pbrt-v4's model (DESIGN.md "Emission"): the medium emits σa(x)·Le(x)
+ * per unit length, so the radiance equation along a ray gains ∫ T(t) σa(t) Le(t) dt. Le is
+ *   EMISSION_COLOR      colour · scale · v(x)           (v: the emission grid, e.g. EmberGen's
+ *                                                        `flames`; 1 without a grid)
+ *   EMISSION_BLACKBODY  scale · B((v(x) − offset) · s)  (v: a temperature grid; pbrt-v4's
+ *                                                        temperatureoffset / temperaturescale)
+ * B is the blackbody colour of host/render/blackbody.h (peak-normalised Planck spectrum through the
+ * CIE 1931 matching functions into linear sRGB, 0 at or below 100 K), tabulated by the host over
+ * [0, table_max] kelvin, table_max at least the hottest temperature the grid can give, and read
+ * with linear interpolation: the table is interpolated, not the colour per voxel, so B follows the
+ * temperature trilinearly reconstructed at x, as pbrt-v4 evaluates it.
+ * The emission grid has its own index space (its own transform and bounding box in the file);
+ * emission_params.index_to_grid maps the medium's index space into it.
+ *
+ * Built only with -DEMISSION (host/render/kernel_features.h): without it nothing here is compiled
+ * and no kernel function carries the emission grid (grid.h). Host code includes it where it
+ * defines EMISSION itself (tests). Who collects it: tracking_delta at every tentative collision
+ * (the path tracer, tracking.h), the ray marcher's view march (raymarch.h) and emission_march (the
+ * Lobe Estimator, lobe.h). */
+#ifndef NARVAL_EMISSION_H
+#define NARVAL_EMISSION_H
+
+#include "shared/grid.h"
+#include "shared/structs.h"
+
+#ifdef EMISSION
+
+/* The emission grid's value at medium index point p (1 without a grid). */
+static inline float emission_grid_value(NV_CONSTANT const emission_params* e, GRID_PARAM, vec3 p) {
+  if (!(e->grid_dims.x > 0.0f)) return 1.0f;
+  const vec3 q = affine_point(e->index_to_grid, p);
+#ifdef NV_DEVICE
+  return grid_value(emission_grid, q);
+#else
+  return grid_trilinear(grid->emission_data, grid->emission_nx, grid->emission_ny, grid->emission_nz, q);
+#endif
+}
+
+/* B(T) from the table: linear interpolation between the entries around T, the last entry above
+ * table_max (the host sizes the table so that no temperature of the grid gets there), 0 for T at or
+ * below 0 and for NaN (the entries up to 100 K are 0 already). */
+static inline vec3 emission_blackbody(NV_CONSTANT const emission_params* e, NV_GLOBAL const float* table, float T) {
+  if (!(T > 0.0f)) return vec3_splat(0.0f);
+  const int last = e->table_size - 1;
+  const float x = nv_fmin(T / e->table_max, 1.0f) * (float)last;
+  const int i = (int)nv_fmin(nv_floor(x), (float)(last - 1));
+  const float a = x - (float)i;
+  NV_GLOBAL const float* lo = table + 3 * i;
+  return vec3_make(lo[0] + a * (lo[3] - lo[0]), lo[1] + a * (lo[4] - lo[1]), lo[2] + a * (lo[5] - lo[2]));
+}
+
+/* Le at medium index point p. An unknown kind emits nothing (reported at the kernel's entry,
+ * scene_kinds.h). */
+static inline vec3 emission_radiance(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 p) {
+  NV_CONSTANT const emission_params* e = &m->emission;
+  switch (e->kind) {
+    case EMISSION_NONE: return vec3_splat(0.0f);
+    case EMISSION_COLOR: return vec3_scale(vec3_from4(e->color), emission_grid_value(e, GRID_ARG, p));
+    case EMISSION_BLACKBODY: {
+#ifdef NV_DEVICE
+      NV_GLOBAL const float* table = emission_table;
+#else
+      const float* table = grid->emission_table;
+#endif
+      const float T = (emission_grid_value(e, GRID_ARG, p) - e->temperature_offset) * e->temperature_scale;
+      return vec3_mul(vec3_from4(e->color), emission_blackbody(e, table, T));
+    }
+    default: return vec3_splat(0.0f);
+  }
+}
+
+/* σa(x)·Le(x), the emitted radiance per unit length at medium index point p of density rho. */
+static inline vec3 emission_source(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 p, float rho) {
+  const vec3 sigma_a = vec3_scale(vec3_from4(m->sigma_a), rho);
+  if (vec3_is_zero(sigma_a)) return sigma_a; /* no absorption, no emission: skip the emission grid */
+  return vec3_mul(sigma_a, emission_radiance(m, GRID_ARG, p));
+}
+
+#endif /* EMISSION */
+
+#endif
