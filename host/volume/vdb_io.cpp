@@ -549,6 +549,33 @@ void writeVdbTestFile(const std::string& path, const std::string& kind) {
     f->tree().setValue(openvdb::Coord(0, 0, 0), 1.0f);
     f->setName("heat");
     grids.push_back(f);
+  } else if (kind == "emission") {
+    // Density "smoke": voxels (0..7)³ = 0.5 at voxel size 1. Emission "heat": voxel size 0.5,
+    // translated by (−1, −1, −1), voxels −1..20 on each axis holding 100 + 10x + 20y + 30z of
+    // their world centre (x, y, z), a field trilinear filtering reproduces exactly; its box
+    // covers the smoke's with a voxel to spare. And a Vec3 grid "velocity".
+    openvdb::FloatGrid::Ptr smoke = openvdb::FloatGrid::create(0.0f);
+    for (int z = 0; z < 8; ++z)
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) smoke->tree().setValue(openvdb::Coord(x, y, z), 0.5f);
+    smoke->setName("smoke");
+    grids.push_back(smoke);
+    openvdb::FloatGrid::Ptr heat = openvdb::FloatGrid::create(0.0f);
+    openvdb::math::Transform::Ptr xf = openvdb::math::Transform::createLinearTransform(0.5);
+    xf->postTranslate(openvdb::Vec3d(-1, -1, -1));
+    heat->setTransform(xf);
+    for (int k = -1; k <= 20; ++k)
+      for (int j = -1; j <= 20; ++j)
+        for (int i = -1; i <= 20; ++i) {
+          const openvdb::Vec3d w = xf->indexToWorld(openvdb::Coord(i, j, k));
+          heat->tree().setValue(openvdb::Coord(i, j, k), float(100 + 10 * w.x() + 20 * w.y() + 30 * w.z()));
+        }
+    heat->setName("heat");
+    grids.push_back(heat);
+    openvdb::Vec3SGrid::Ptr v = openvdb::Vec3SGrid::create();
+    v->tree().setValue(openvdb::Coord(1, 2, 3), openvdb::Vec3s(1, 0, 0));
+    v->setName("velocity");
+    grids.push_back(v);
   } else if (kind == "frustum") {
     openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
     f->tree().setValue(openvdb::Coord(1, 1, 1), 1.0f);

@@ -36,11 +36,14 @@ static inline float emission_grid_value(NV_CONSTANT const emission_params* e, GR
 #endif
 }
 
+/* Nothing is emitted at or below this temperature (pbrt-v4's rule), whatever the table holds. */
+#define EMISSION_MIN_KELVIN 100.0f
+
 /* B(T) from the table: linear interpolation between the entries around T, the last entry above
- * table_max (the host sizes the table so that no temperature of the grid gets there), 0 for T at or
- * below 0 and for NaN (the entries up to 100 K are 0 already). */
+ * table_max (the host sizes the table so that no temperature of the grid gets there), exactly 0
+ * for T at or below EMISSION_MIN_KELVIN and for NaN. */
 static inline vec3 emission_blackbody(NV_CONSTANT const emission_params* e, NV_GLOBAL const float* table, float T) {
-  if (!(T > 0.0f)) return vec3_splat(0.0f);
+  if (!(T > EMISSION_MIN_KELVIN)) return vec3_splat(0.0f);
   const int last = e->table_size - 1;
   const float x = nv_fmin(T / e->table_max, 1.0f) * (float)last;
   const int i = (int)nv_fmin(nv_floor(x), (float)(last - 1));

@@ -433,7 +433,7 @@ TEST_F(SharedOnDevice, TrackingDeltaChromaticHomogeneous) {
   beta.report();
 }
 
-// Kinds: every kernel's entry flags a phase function or light kind it does not know
+// Kinds: every kernel's entry flags a phase function, light or emission kind it does not know
 // (STATUS_UNKNOWN_KIND), and the switches give such a kind nothing: phase_eval 0, phase_sample's
 // pdf 0, no light sample. Known kinds: status 0 and their ordinary values.
 TEST_F(SharedOnDevice, UnknownKindsSetTheStatusBitAndSendNothing) {
@@ -484,6 +484,17 @@ TEST_F(SharedOnDevice, UnknownKindsSetTheStatusBitAndSendNothing) {
   s.has_medium = 0;  // without a medium the phase kind is not looked at
   s.medium.phase = 7;
   lights[0].type = lights[1].type = LIGHT_POINT;
+  EXPECT_EQ(probe()[0], 0u);
+
+  // Emission kinds: an unknown one, and an emitting medium reaching a kernel built without
+  // -DEMISSION (this one), which could not show its light.
+  s.has_medium = 1;
+  s.medium.phase = PHASE_ISOTROPIC;
+  s.medium.emission.kind = 9;
+  EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
+  s.medium.emission.kind = EMISSION_COLOR;
+  EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
+  s.medium.emission.kind = EMISSION_NONE;
   EXPECT_EQ(probe()[0], 0u);
 }
 

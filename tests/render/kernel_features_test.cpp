@@ -24,6 +24,7 @@ struct SceneSpec {
   bool rect, point;   // which lights
   bool lens;          // thin lens (aperture > 0)
   bool medium = true;
+  bool emits = false; // the medium emits (a constant colour: emission.h)
 };
 
 std::string sceneJson(const SceneSpec& s) {
@@ -43,7 +44,8 @@ std::string sceneJson(const SceneSpec& s) {
     {"name": "bulb", "type": "emitter", "albedo": [4, 3, 2]},
     {"name": "cloud", "type": "volume", "scattering": )") +
          scattering + R"(, "absorption": )" + absorption + R"(, "phaseFunction": ")" + s.phase +
-         R"(", "g": 0.6, "density": 3}
+         R"(", "g": 0.6, "density": 3)" +
+         (s.emits ? R"(, "emission": {"color": [0.5, 0.3, 0.1], "scale": 2})" : "") + R"(}
   ],
   "primitives": [
 )" + prims + R"(
@@ -80,6 +82,10 @@ TEST(KernelFeatures, OptionsDerivedFromTheScene) {
        "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED_HG -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE"},
       // No medium: no phase or σ feature.
       {{"hg", false, true, false, true, false}, false, "-DLIGHTS_RECT_ONLY", "-DMEDIUM_HOMOGENEOUS -DLIGHTS_RECT_ONLY"},
+      // An emitting medium: its kernels carry emission (emission.h).
+      {{"hg", true, true, false, false, true, true}, false,
+       "-DPHASE_FIXED_HG -DMEDIUM_GREY -DEMISSION -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE",
+       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED_HG -DMEDIUM_GREY -DEMISSION -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE"},
       // No light at all: nothing to intersect, as with point lights only.
       {{"isotropic", true, false, false, false}, true,
        "-DPHASE_FIXED_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE",
@@ -93,7 +99,8 @@ TEST(KernelFeatures, OptionsDerivedFromTheScene) {
     GenericKernels generic;
     EXPECT_FALSE(kernelSpecialisationEnabled());
     const DeviceScene g = buildDeviceScene(sceneFromJson(json), c.grid ? &cloud : nullptr);
-    EXPECT_EQ(g.buildOptions, c.grid && c.spec.medium ? "" : "-DMEDIUM_HOMOGENEOUS") << json;
+    // The generic kernel carries every branch, emission's too.
+    EXPECT_EQ(g.buildOptions, c.grid && c.spec.medium ? "-DEMISSION" : "-DMEDIUM_HOMOGENEOUS -DEMISSION") << json;
     EXPECT_EQ(sceneFeatureOptions(g), c.features);  // the derivation itself ignores the switch
   }
   setenv("NARVAL_GENERIC", "0", 1);
@@ -150,6 +157,14 @@ TEST(KernelFeatures, UnknownKindsAreAnErrorOnTheHost) {
   } catch (const std::logic_error& e) {
     EXPECT_STREQ(e.what(), "the kernels know no light kind 5");
   }
+  ds.lights[0].type = LIGHT_RECTANGLE;
+  ds.params.medium.emission.kind = 9;
+  try {
+    sceneBuildOptions(ds);
+    FAIL() << "no error";
+  } catch (const std::logic_error& e) {
+    EXPECT_STREQ(e.what(), "the kernels know no emission kind 9");
+  }
 }
 
 // Each scene switches on a different set of features (see OptionsDerivedFromTheScene).
@@ -165,6 +180,14 @@ TEST(KernelFeatures, IsotropicGreyRectOnlyPinholeSameAsGeneric) {
 
 TEST(KernelFeatures, HgGreyPointOnlyHomogeneousSameAsGeneric) {
   expectSpecialisedEqualsGeneric({"hg", true, false, true, false}, nullptr);
+}
+
+// Emission: the generic kernel (-DEMISSION, the kind tested at run time) gives an emitting scene the
+// same bits as its specialised kernel; the non-emitting scenes above check that emission code built
+// in but switched off (EMISSION_NONE) changes no pixel either.
+TEST(KernelFeatures, EmittingChromaticGridSameAsGeneric) {
+  const DenseGrid cloud = makeCloud(16, 3);
+  expectSpecialisedEqualsGeneric({"hg", false, true, false, false, true, true}, &cloud);
 }
 
 TEST(KernelFeatures, IsotropicChromaticPointOnlyGridSameAsGeneric) {

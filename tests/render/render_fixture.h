@@ -26,7 +26,7 @@ inline Scene sceneFromJson(const std::string& json) { return parseScene(json, "t
 
 // The path tracer. Every render helper takes the grid storage from the scene (renderer.storage;
 // auto: the buffer on PoCL), as the CLI does.
-inline RenderResult render(const Scene& scene, const DenseGrid* grid = nullptr, int lx = 8, int ly = 8) {
+inline RenderResult render(const Scene& scene, SceneGrids grid = {}, int lx = 8, int ly = 8) {
   RenderOptions o;
   o.localSizeX = lx;
   o.localSizeY = ly;
@@ -34,7 +34,7 @@ inline RenderResult render(const Scene& scene, const DenseGrid* grid = nullptr, 
 }
 
 // The scene's own renderer.algorithm (one frame for the real-time ones).
-inline RenderResult renderAlgorithm(const Scene& scene, const DenseGrid* grid = nullptr) {
+inline RenderResult renderAlgorithm(const Scene& scene, SceneGrids grid = {}) {
   if (scene.renderer.algorithm == Algorithm::Pathtrace) return render(scene, grid);
   return renderRealtime(runtime(), scene, grid, 1, RenderOptions{});
 }
@@ -48,7 +48,7 @@ inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "rayma
 
 // `scene` rendered by one of kHardCaseRenderers (or any algorithm name), one frame for the
 // real-time ones.
-inline RenderResult renderWith(Scene scene, const std::string& renderer, const DenseGrid* grid = nullptr) {
+inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGrids grid = {}) {
   if (renderer == "raymarch+ms-cache") {
     scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
