@@ -137,7 +137,8 @@ struct LobeSettings {
   int lobePoints = 30;
   float lobeRadius = 1.0f;       // eq7: world units; corrected: mean free paths of unit density
   int shadowSteps = 100;
-  int firstHitSteps = 60;        // samples of the first-hit search (then 6 bisections)
+  int firstHitSteps = 60;        // samples of the first-hit search (then 6 bisections); both
+                                 // variants: of the emission march (lobe.h)
   int viewSteps = 0;             // samples of each transmittance from the first hit to a lobe point
                                  // (corrected: of its one view march); 0 = the variant's: eq7 24, corrected 16
   float minTransmittance = 1e-3f;  // those transmittances stop below it (lobe.h: error < it · L_b)

@@ -78,7 +78,7 @@
 // |   lobe.lobeRadius       | number: eq7 world units,        |     | 1           | >= 0                       |
 // |                         | corrected mean free paths       |     |             |                            |
 // |   lobe.shadowSteps      | integer                         |     | 100         | >= 1                       |
-// |   lobe.firstHitSteps    | integer (eq7)                   |     | 60          | >= 1                       |
+// |   lobe.firstHitSteps    | integer (eq7; both: emission)   |     | 60          | >= 1                       |
 // |   lobe.viewSteps        | integer: Tr(x0 -> P_i) samples; |     | eq7 24,     | >= 1                       |
 // |                         | corrected: the one view march   |     | corrected 16|                            |
 // |   lobe.minTransmittance | number: Tr(x0 -> P_i) stops     |     | 0.001       | [0, 1); 0 = never          |

@@ -92,8 +92,8 @@
  * Result: L = L_b·T_v + (1 − T_v)·albedo ⊙ (1/n) Σ_i Σ_k p(cos θ_i) · Tr(P_i → light_k) · I_k / d².
  * Loops: one march of view_steps, n × lights lookups; no first-hit search, no view marches.
  *
- * Emission (-DEMISSION, emission.h): both variants add march_emission over the view ray's segment,
- * the medium's own light, which neither estimate above holds.
+ * Emission (-DEMISSION, emission.h): both variants add march_emission over the view ray's segment
+ * (`steps` samples), the medium's own light, which neither estimate above holds.
  *
  * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density, phase value or
  * lobe point met on the way; STATUS_ITERATION_CAP from a DDA walk. No pdf: never
@@ -324,10 +324,9 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
                      ? lobe_radiance_corrected(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status)
                      : lobe_radiance_eq7(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status);
 #ifdef EMISSION
-  /* The medium's own light, marched with the variant's view-ray samples (eq7: its first-hit search's
-   * `steps`; corrected: its view march's view_steps). */
-  return vec3_add(L, march_emission(&s->medium, GRID_ARG, &seg, corrected ? p->view_steps : p->steps,
-                                    p->min_transmittance, status));
+  /* The medium's own light, marched with `steps` samples in both variants (the first-hit search's,
+   * 60 by default): corrected's view march has view_steps = 16, which aliases a fire's flames. */
+  return vec3_add(L, march_emission(&s->medium, GRID_ARG, &seg, p->steps, p->min_transmittance, status));
 #else
   return L;
 #endif
