@@ -19,5 +19,6 @@ Command addMakeCloudCommand(CLI::App& app);
 Command addCompareCommand(CLI::App& app);
 Command addSweepCommand(CLI::App& app);
 Command addViewCommand(CLI::App& app);
+Command addInfoCommand(CLI::App& app);
 
 }  // namespace narval

@@ -37,6 +37,7 @@
 #include <tbb/task_arena.h>
 
 #include "scene/input_error.h"
+#include "volume/grid_info.h"
 
 namespace narval {
 namespace {
@@ -262,6 +263,69 @@ std::vector<std::string> floatGridNames(const std::string& path) {
   return names;
 }
 
+// Every grid of the file read whole and described (grid_info.h). Throws InputError.
+std::vector<GridInfo> describeVdbGrids(const std::string& path) {
+  std::vector<GridInfo> out;
+  openvdb::GridPtrVecPtr grids;
+  try {
+    grids = readAllGrids(path);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw inputError(path, "", "not a readable OpenVDB file (" + oneLine(e.what()) + ")");
+  }
+  for (const openvdb::GridBase::Ptr& g : *grids) {
+    GridInfo info;
+    info.name = g->getName();
+    info.valueType = g->valueType();
+    info.gridClass = openvdb::GridBase::gridClassToString(g->getGridClass());
+    info.activeVoxels = g->activeVoxelCount();
+    info.memoryBytes = g->memUsage();
+    const openvdb::Vec3d vs = g->voxelSize();
+    info.voxelSize = {vs.x(), vs.y(), vs.z()};
+    const openvdb::CoordBBox bbox = g->evalActiveVoxelBoundingBox();
+    if (info.activeVoxels > 0 && !bbox.empty()) {
+      for (int a = 0; a < 3; ++a) {
+        info.indexMin[size_t(a)] = bbox.min()[a];
+        info.indexMax[size_t(a)] = bbox.max()[a];
+        info.worldMin[size_t(a)] = INFINITY;
+        info.worldMax[size_t(a)] = -INFINITY;
+      }
+      for (int corner = 0; corner < 8; ++corner) {
+        const openvdb::Vec3d p(corner & 1 ? bbox.max().x() + 0.5 : bbox.min().x() - 0.5,
+                               corner & 2 ? bbox.max().y() + 0.5 : bbox.min().y() - 0.5,
+                               corner & 4 ? bbox.max().z() + 0.5 : bbox.min().z() - 0.5);
+        const openvdb::Vec3d w = g->transform().indexToWorld(p);
+        for (int a = 0; a < 3; ++a) {
+          info.worldMin[size_t(a)] = std::min(info.worldMin[size_t(a)], w[a]);
+          info.worldMax[size_t(a)] = std::max(info.worldMax[size_t(a)], w[a]);
+        }
+      }
+      const openvdb::Coord dim = bbox.dim();
+      if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(g)) {
+        info.denseBytes = uint64_t(dim.x()) * uint64_t(dim.y()) * uint64_t(dim.z()) * sizeof(float);
+        info.hasRange = true;
+        info.valueMin = INFINITY;
+        info.valueMax = -INFINITY;
+        for (auto v = f->cbeginValueOn(); v; ++v) {
+          info.valueMin = std::min(info.valueMin, double(*v));
+          info.valueMax = std::max(info.valueMax, double(*v));
+        }
+      } else if (auto v3 = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g)) {
+        info.hasRange = true;
+        info.valueMin = INFINITY;
+        info.valueMax = -INFINITY;
+        for (auto v = v3->cbeginValueOn(); v; ++v) {
+          info.valueMin = std::min(info.valueMin, double(v->length()));
+          info.valueMax = std::max(info.valueMax, double(v->length()));
+        }
+      }
+    }
+    out.push_back(info);
+  }
+  return out;
+}
+
 #if defined(__linux__)
 // OpenVDB 10's readers trust the sizes and flags they find in a file. Corrupted bytes inside
 // compressed leaf data (a size field larger than its buffer, a wrong mask flag) overflow a heap
@@ -434,9 +498,38 @@ bool namesInChild(const std::string& path, std::vector<std::string>& names) {
   }
   return true;
 }
+
+bool describeInChild(const std::string& path, std::vector<GridInfo>& infos) {
+  Fd mem;
+  ChildRecord rec{};
+  auto work = [&](int fd, ChildRecord& result) {
+    const std::string text = gridInfoJson(path, describeVdbGrids(path));
+    result.payloadBytes = uint32_t(text.size());
+    if (::pwrite(fd, text.data(), text.size(), off_t(kDataOffset)) != ssize_t(text.size())) {
+      throw std::runtime_error("cannot pass the grids' description back");
+    }
+  };
+  if (!runInChild(path, "cannot describe the grids", work, mem, rec)) return false;
+  std::string text(rec.payloadBytes, '\0');
+  if (::pread(mem.fd, text.data(), text.size(), off_t(kDataOffset)) != ssize_t(text.size())) {
+    throw inputError(path, "grid", "cannot describe the grids (the reader process returned an inconsistent result)");
+  }
+  infos = gridInfoFromJson(text);
+  return true;
+}
 #endif
 
 }  // namespace
+
+std::vector<GridInfo> inspectVdb(const std::string& path) {
+  initOpenVdb();
+  requireReadableFile(path);
+#if defined(__linux__)
+  std::vector<GridInfo> infos;
+  if (describeInChild(path, infos)) return infos;
+#endif
+  return describeVdbGrids(path);
+}
 
 std::vector<std::string> vdbGridNames(const std::string& path) {
   initOpenVdb();
