@@ -4,16 +4,16 @@
 #include "shared/scene_kinds.h"
 #include "shared/light_cache.h"
 
-__kernel void light_cache_build(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
+__kernel void light_cache_build(KERNEL_SCENE_ARGS,
                                 __constant realtime_params* params, int light, __global float* cache,
                                 __global uint* status_word) {
   const int node = get_global_id(0);
   __constant node_grid_params* c = &params->light_cache;
   const int nodes = node_grid_count(c);
   if (node >= nodes) return;
-  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
-  cache[(size_t)light * (size_t)nodes + (size_t)node] =
-      light_cache_build_node(&scene->medium, GRID_ARG, c, params->shadow_steps, params->shadow_area_samples,
-                             &lights[light], node, &status);
-  if (status) atomic_or(status_word, status);
+  KERNEL_CONTEXT_BEGIN(ctx);
+  ctx.status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
+  cache[(size_t)light * (size_t)nodes + (size_t)node] = light_cache_build_node(
+      KERNEL_ENTRY_ARG(ctx), c, params->shadow_steps, params->shadow_area_samples, &lights[light], node);
+  if (ctx.status) atomic_or(status_word, ctx.status);
 }

@@ -6,16 +6,17 @@
 #include "shared/scene_kinds.h"
 #include "shared/lobe.h"
 
-__kernel void lobe(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
+__kernel void lobe(KERNEL_SCENE_ARGS,
                    __constant realtime_params* params, __global const float4* lobe_directions,
                    __global const float* light_cache, __global const float* ms_cache, __global float4* out,
                    __global uint* status_word) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
-  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
+  KERNEL_CONTEXT_BEGIN(ctx);
+  ctx.status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
   /* float4 and nv_float4 hold the same four floats (structs.h). */
-  const vec3 L = lobe_pixel(scene, lights, GRID_ARG, params, (__global const nv_float4*)lobe_directions, light_cache,
-                            x, y, &status);
+  const vec3 L =
+      lobe_pixel(KERNEL_ENTRY_ARG(ctx), params, (__global const nv_float4*)lobe_directions, light_cache, x, y);
   out[y * scene->camera.width + x] = (float4)(L.x, L.y, L.z, 0.0f);
-  if (status) atomic_or(status_word, status);
+  if (ctx.status) atomic_or(status_word, ctx.status);
 }

@@ -4,14 +4,14 @@
 #include "shared/scene_kinds.h"
 #include "shared/ms_cache_build.h"
 
-__kernel void ms_cache_build(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
+__kernel void ms_cache_build(KERNEL_SCENE_ARGS,
                              __constant realtime_params* params, uint first, uint count, __global float* cache,
                              __global uint* status_word) {
   const int node = get_global_id(0);
   __constant node_grid_params* c = &params->ms_cache;
   if (node >= node_grid_count(c)) return;
-  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
-  ms_cache_refine_node(scene, lights, GRID_ARG, c, node, cache + (size_t)node * MS_CACHE_STRIDE, first, count,
-                       &status);
-  if (status) atomic_or(status_word, status);
+  KERNEL_CONTEXT_BEGIN(ctx);
+  ctx.status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
+  ms_cache_refine_node(KERNEL_ENTRY_ARG(ctx), c, node, cache + (size_t)node * MS_CACHE_STRIDE, first, count);
+  if (ctx.status) atomic_or(status_word, ctx.status);
 }

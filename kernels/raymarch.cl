@@ -6,14 +6,15 @@
 #include "shared/scene_kinds.h"
 #include "shared/raymarch.h"
 
-__kernel void raymarch(__constant scene_params* scene, __constant light_params* lights, GRID_KERNEL_PARAM,
+__kernel void raymarch(KERNEL_SCENE_ARGS,
                        __constant realtime_params* params, __global const float4* lobe_directions,
                        __global const float* light_cache, __global const float* ms_cache, __global float4* out,
                        __global uint* status_word) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
-  uint status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
-  const vec3 L = raymarch_pixel(scene, lights, GRID_ARG, params, light_cache, ms_cache, x, y, &status);
+  KERNEL_CONTEXT_BEGIN(ctx);
+  ctx.status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
+  const vec3 L = raymarch_pixel(KERNEL_ENTRY_ARG(ctx), params, light_cache, ms_cache, x, y);
   out[y * scene->camera.width + x] = (float4)(L.x, L.y, L.z, 0.0f);
-  if (status) atomic_or(status_word, status);
+  if (ctx.status) atomic_or(status_word, ctx.status);
 }

@@ -143,7 +143,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
   std::atomic<int> nextRow{0};
   std::atomic<uint32_t> statusAll{0};
   auto worker = [&]() {
-    uint32_t status = 0u;
+    kernel_context ctx = kernel_context_host(sp, lights, nullptr, grid);  // one per thread: its status
     for (int y = nextRow.fetch_add(1, std::memory_order_relaxed); y < H;
          y = nextRow.fetch_add(1, std::memory_order_relaxed)) {
       float* row = rgba.data() + size_t(y) * size_t(W) * 4;
@@ -153,7 +153,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
           case Algorithm::Pathtrace: {
             float ax = 0.0f, ay = 0.0f, az = 0.0f, cx = 0.0f, cy = 0.0f, cz = 0.0f;
             for (int s = 0; s < spp; ++s) {
-              const vec3 v = pathtrace_sample(sp, lights, grid, x, y, uint(s), &status);
+              const vec3 v = pathtrace_sample(&ctx, x, y, uint(s));
               accum_kahan_add(&ax, &cx, v.x);
               accum_kahan_add(&ay, &cy, v.y);
               accum_kahan_add(&az, &cz, v.z);
@@ -162,16 +162,16 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
             break;
           }
           case Algorithm::Raymarch:
-            L = raymarch_pixel(sp, lights, grid, rp, cache, o.msCache.data(), x, y, &status);
+            L = raymarch_pixel(&ctx, rp, cache, o.msCache.data(), x, y);
             break;
-          case Algorithm::Lobe: L = lobe_pixel(sp, lights, grid, rp, dirs, cache, x, y, &status); break;
+          case Algorithm::Lobe: L = lobe_pixel(&ctx, rp, dirs, cache, x, y); break;
         }
         row[size_t(x) * 4 + 0] = L.x;
         row[size_t(x) * 4 + 1] = L.y;
         row[size_t(x) * 4 + 2] = L.z;
       }
     }
-    statusAll.fetch_or(status, std::memory_order_relaxed);
+    statusAll.fetch_or(ctx.status, std::memory_order_relaxed);
   };
 
   NativeResult r;

@@ -6,9 +6,10 @@
 namespace narval {
 namespace {
 
-// The arguments every narval kernel starts with (device_scene.h binds them): the scene, its lights,
-// the density grid (an image, a buffer, or an unused int for a homogeneous medium; grid.h's
-// GRID_PARAM) and the majorant grid's cells.
+// The arguments every narval kernel starts with (device_scene.h binds them; kernel_context.h's
+// KERNEL_SCENE_ARGS): the scene, its lights, the density grid (an image, a buffer, or an unused int
+// for a homogeneous medium), the majorant grid's cells, the emission grid (likewise) and the
+// blackbody table.
 const std::vector<std::string> kSceneArgs = {"scene", "lights", "grid", "grid_majorants", "emission_grid",
                                              "emission_table"};
 

@@ -1,7 +1,7 @@
 // device_scene.h: a scene resident on one device: the scene and light buffers, the density grid
 // and its majorant cells, the emission grid and the blackbody table, bound as the first six
-// arguments every narval kernel takes (scene, lights, then GRID_KERNEL_PARAM: grid, majorant cells,
-// emission grid, blackbody table).
+// arguments every narval kernel takes (kernel_context.h's KERNEL_SCENE_ARGS: scene, lights, grid,
+// majorant cells, emission grid, blackbody table).
 #pragma once
 
 #include "cl/cl_runtime.h"

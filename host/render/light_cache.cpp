@@ -24,12 +24,11 @@ std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view*
   const node_grid_params& c = params.light_cache;
   const int nodes = node_grid_count(&c);
   std::vector<float> cache(size_t(nodes) * size_t(ds.params.num_lights));
-  uint32_t status = 0;
+  kernel_context ctx = kernel_context_host(&ds.params, ds.lights.data(), nullptr, grid);
   for (int l = 0; l < ds.params.num_lights; ++l)
     for (int n = 0; n < nodes; ++n)
       cache[size_t(l) * size_t(nodes) + size_t(n)] =
-          light_cache_build_node(&ds.params.medium, grid, &c, params.shadow_steps, params.shadow_area_samples,
-                                 &ds.lights[size_t(l)], n, &status);
+          light_cache_build_node(&ctx, &c, params.shadow_steps, params.shadow_area_samples, &ds.lights[size_t(l)], n);
   return cache;
 }
 

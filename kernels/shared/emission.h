@@ -13,26 +13,29 @@
  * emission_params.index_to_grid maps the medium's index space into it.
  *
  * Built only with -DEMISSION (host/render/kernel_features.h): without it nothing here is compiled
- * and no kernel function carries the emission grid (grid.h). Host code includes it where it
- * defines EMISSION itself (tests). Who collects it: tracking_delta at every tentative collision
- * (the path tracer, tracking.h), the ray marcher's view march (raymarch.h) and emission_march (the
- * Lobe Estimator, lobe.h). */
+ * and no kernel function reads the emission grid or table (kernel_context.h holds them). Host code
+ * includes it where it defines EMISSION itself (tests). Who collects it: tracking_delta at every
+ * tentative collision (the path tracer, tracking.h), the ray marcher's view march (raymarch.h) and
+ * march_emission (the Lobe Estimator, lobe.h). */
 #ifndef NARVAL_EMISSION_H
 #define NARVAL_EMISSION_H
 
-#include "shared/grid.h"
-#include "shared/structs.h"
+#include "shared/kernel_context.h"
 
 #ifdef EMISSION
 
 /* The emission grid's value at medium index point p (1 without a grid). */
-static inline float emission_grid_value(NV_CONSTANT const emission_params* e, GRID_PARAM, vec3 p) {
+static inline float emission_grid_value(KERNEL_CONTEXT_PARAM, vec3 p) {
+  NV_CONSTANT const emission_params* e = &ctx->medium->emission;
   if (!(e->grid_dims.x > 0.0f)) return 1.0f;
   const vec3 q = affine_point(e->index_to_grid, p);
-#ifdef NV_DEVICE
-  return grid_value(emission_grid, q);
+#if !defined(NV_DEVICE)
+  const grid_view* g = ctx->grids;
+  return grid_trilinear(g->emission_data, g->emission_nx, g->emission_ny, g->emission_nz, q);
+#elif GRID_STORAGE_IN_CONTEXT
+  return grid_value(ctx->emission_grid, q);
 #else
-  return grid_trilinear(grid->emission_data, grid->emission_nx, grid->emission_ny, grid->emission_nz, q);
+  return grid_value(emission_image, q);
 #endif
 }
 
@@ -54,18 +57,18 @@ static inline vec3 emission_blackbody(NV_CONSTANT const emission_params* e, NV_G
 
 /* Le at medium index point p. An unknown kind emits nothing (reported at the kernel's entry,
  * scene_kinds.h). */
-static inline vec3 emission_radiance(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 p) {
-  NV_CONSTANT const emission_params* e = &m->emission;
+static inline vec3 emission_radiance(KERNEL_CONTEXT_PARAM, vec3 p) {
+  NV_CONSTANT const emission_params* e = &ctx->medium->emission;
   switch (e->kind) {
     case EMISSION_NONE: return vec3_splat(0.0f);
-    case EMISSION_COLOR: return vec3_scale(vec3_from4(e->color), emission_grid_value(e, GRID_ARG, p));
+    case EMISSION_COLOR: return vec3_scale(vec3_from4(e->color), emission_grid_value(KERNEL_CONTEXT_ARG, p));
     case EMISSION_BLACKBODY: {
 #ifdef NV_DEVICE
-      NV_GLOBAL const float* table = emission_table;
+      NV_GLOBAL const float* table = ctx->emission_table;
 #else
-      const float* table = grid->emission_table;
+      const float* table = ctx->grids->emission_table;
 #endif
-      const float T = (emission_grid_value(e, GRID_ARG, p) - e->temperature_offset) * e->temperature_scale;
+      const float T = (emission_grid_value(KERNEL_CONTEXT_ARG, p) - e->temperature_offset) * e->temperature_scale;
       return vec3_mul(vec3_from4(e->color), emission_blackbody(e, table, T));
     }
     default: return vec3_splat(0.0f);
@@ -73,10 +76,10 @@ static inline vec3 emission_radiance(NV_CONSTANT const medium_params* m, GRID_PA
 }
 
 /* σa(x)·Le(x), the emitted radiance per unit length at medium index point p of density rho. */
-static inline vec3 emission_source(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 p, float rho) {
-  const vec3 sigma_a = vec3_scale(vec3_from4(m->sigma_a), rho);
+static inline vec3 emission_source(KERNEL_CONTEXT_PARAM, vec3 p, float rho) {
+  const vec3 sigma_a = vec3_scale(vec3_from4(ctx->medium->sigma_a), rho);
   if (vec3_is_zero(sigma_a)) return sigma_a; /* no absorption, no emission: skip the emission grid */
-  return vec3_mul(sigma_a, emission_radiance(m, GRID_ARG, p));
+  return vec3_mul(sigma_a, emission_radiance(KERNEL_CONTEXT_ARG, p));
 }
 
 #endif /* EMISSION */

@@ -1,7 +1,7 @@
-/* grid.h: the one function through which every kernel reads density, grid_density(GRID_ARG, p),
- * with p in grid index space (voxel i covers [i, i+1], centre i + 0.5; trilinear; 0 outside).
- * Storage is chosen here and nowhere else; the kernel signatures are the same for every choice
- * (GRID_KERNEL_PARAM is always two arguments: the grid, then the majorant cells):
+/* grid.h: how a grid is stored and read, grid_value(g, p) (the kernels read density through
+ * kernel_context.h's grid_density(ctx, p)), with p in grid index space (voxel i covers [i, i+1],
+ * centre i + 0.5; trilinear; 0 outside). Storage is chosen here and nowhere else; the kernels'
+ * arguments are the same for every choice (GRID_STORAGE is the type of a grid argument):
  * - device, -D MEDIUM_HOMOGENEOUS: 1 everywhere (the grid argument is an unused int);
  * - device, -D GRID_STORAGE_BUFFER: a __global float buffer (GRID_BUFFER_HEADER, then the voxels,
  *   x fastest) filtered by grid_trilinear below: the code the host runs;
@@ -11,8 +11,8 @@
  * - device, otherwise: a 3D image (CL_R, CL_FLOAT) read with the sampler (hardware filtering);
  * - host: grid_trilinear on a float array, so tests and a native baseline see the same field.
  * The host picks the storage per device (render/device_grid.h, scene key renderer.storage).
- * GRID_PARAM also carries the majorant grid's per-cell bounds (GRID_MAJORANTS), so every function
- * that reads density can skip empty space (march.h) without another parameter.
+ * The kernel context (kernel_context.h) also carries the majorant grid's per-cell bounds
+ * (GRID_MAJORANTS), so every function that reads density can skip empty space (march.h).
  *
  * Image and buffer reconstruct the same field; they differ in arithmetic only:
  * - Addressing: the sampler is CLK_ADDRESS_CLAMP (border colour 0: density outside the grid is 0,
@@ -194,22 +194,13 @@ static inline float grid_value(GRID_STORAGE g, vec3 p) {
 }
 #endif
 
-/* Every kernel takes the density grid, the majorant cells, the emission grid and the blackbody
- * table (GRID_KERNEL_PARAM: the host binds the same list for every build, cl/kernel_args.h); the
- * functions below the entry carry the emission pair only in an -DEMISSION build, so a scene without
- * emission compiles no emission code at all. */
-#ifdef EMISSION
-#define GRID_PARAM GRID_STORAGE grid, NV_GLOBAL const float* grid_majorants, GRID_STORAGE emission_grid, \
-                   NV_GLOBAL const float* emission_table
-#define GRID_ARG grid, grid_majorants, emission_grid, emission_table
-#define GRID_KERNEL_PARAM GRID_PARAM
+/* Whether a grid of this storage can be a field of the kernels' context struct
+ * (kernel_context.h): everything but an image (OpenCL C forbids images in structs). */
+#if defined(MEDIUM_HOMOGENEOUS) || defined(GRID_STORAGE_BRICKS) || defined(GRID_STORAGE_BUFFER)
+#define GRID_STORAGE_IN_CONTEXT 1
 #else
-#define GRID_PARAM GRID_STORAGE grid, NV_GLOBAL const float* grid_majorants
-#define GRID_ARG grid, grid_majorants
-#define GRID_KERNEL_PARAM GRID_PARAM, GRID_STORAGE emission_grid, NV_GLOBAL const float* emission_table
+#define GRID_STORAGE_IN_CONTEXT 0
 #endif
-#define GRID_MAJORANTS grid_majorants
-static inline float grid_density(GRID_PARAM, vec3 p) { return grid_value(grid, p); }
 
 #else /* host */
 
@@ -223,16 +214,12 @@ typedef struct grid_view {
   int emission_nx, emission_ny, emission_nz;
   const float* emission_table;
 } grid_view;
-#define GRID_PARAM const grid_view* grid
-#define GRID_ARG grid
-#define GRID_MAJORANTS (grid->majorants)
-#define GRID_IS_HOMOGENEOUS(g) ((g)->data == 0)
 
-static inline float grid_density(GRID_PARAM, vec3 p) {
-  if (!grid->data) return 1.0f;
-  return grid_trilinear(grid->data, grid->nx, grid->ny, grid->nz, p);
+/* The density of a host grid view at index-space point p (what grid_density reads on the host). */
+static inline float grid_view_density(const grid_view* g, vec3 p) {
+  if (!g->data) return 1.0f;
+  return grid_trilinear(g->data, g->nx, g->ny, g->nz, p);
 }
-
 #endif
 
 #endif

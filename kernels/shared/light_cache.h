@@ -35,11 +35,13 @@
  * the kernel's shadow quadrature (march_light_column: with K > 1 a rectangle's effective column
  * over its K×K points); 0 when the light sits on the node (nothing lies between).
  * Status word: STATUS_NAN for a NaN node point or column; STATUS_ITERATION_CAP from a DDA walk. */
-static inline float light_cache_build_node(NV_CONSTANT const medium_params* m, GRID_PARAM,
+static inline float light_cache_build_node(KERNEL_CONTEXT_PARAM,
                                            NV_CONSTANT const node_grid_params* c, int shadow_steps, int K,
-                                           NV_CONSTANT const light_params* l, int node, NV_PRIVATE uint* status) {
+                                           NV_CONSTANT const light_params* l, int node) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  NV_PRIVATE uint* status = &ctx->status;
   const vec3 x = affine_point(c->index_to_world, node_grid_point(c, vec3_from4(m->dims), node));
-  const float column = march_light_column(m, GRID_ARG, l, x, K, shadow_steps, status);
+  const float column = march_light_column(KERNEL_CONTEXT_ARG, l, x, K, shadow_steps);
   if (column != column) *status |= STATUS_NAN; /* a NaN density on the way: said, not cached silently */
   return column;
 }
@@ -71,18 +73,20 @@ static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_CO
  * channel: one cache lookup when the cache is on, else the exact shadow march of shadow_steps
  * samples (the kernels' pixels before the cache, bit for bit). Both real-time kernels call this
  * for every shadow ray. */
-static inline vec3 light_cache_optical_depth(NV_CONSTANT const medium_params* m, GRID_PARAM,
+static inline vec3 light_cache_optical_depth(KERNEL_CONTEXT_PARAM,
                                              NV_CONSTANT const realtime_params* rp, NV_GLOBAL const float* cache,
-                                             NV_CONSTANT const light_params* lights, int light, vec3 x, vec3 dir,
-                                             float dist, NV_PRIVATE uint* status) {
+                                             int light, vec3 x, vec3 dir, float dist) {
+  NV_CONSTANT const light_params* lights = ctx->lights;
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  NV_PRIVATE uint* status = &ctx->status;
   const vec3 sigma_t_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
   if (rp->light_cache.nx > 0)
     return vec3_scale(sigma_t_unit, light_cache_column(m, &rp->light_cache, cache, light, x, dir, dist, status));
   if (rp->shadow_area_samples > 1 && LIGHT_IS_RECT(&lights[light])) /* the columns the cache would hold */
     return vec3_scale(sigma_t_unit,
-                      march_light_column(m, GRID_ARG, &lights[light], x, rp->shadow_area_samples, rp->shadow_steps,
-                                         status));
-  return march_optical_depth(m, GRID_ARG, x, dir, dist, rp->shadow_steps, status);
+                      march_light_column(KERNEL_CONTEXT_ARG, &lights[light], x, rp->shadow_area_samples,
+                                         rp->shadow_steps));
+  return march_optical_depth(KERNEL_CONTEXT_ARG, x, dir, dist, rp->shadow_steps);
 }
 
 #endif

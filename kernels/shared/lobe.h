@@ -119,20 +119,21 @@ static inline vec3 lobe_view_dir(NV_CONSTANT const camera_params* c, float px, f
 /* First parameter in [seg.t0, seg.t1] where the density is above zero; 0 when there is none. The
  * search samples the occupied cells only (march_iter), then bisects between the last empty sample
  * (or the start of the occupied piece) and the first non-empty one. */
-static inline int lobe_first_hit(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_PRIVATE const medium_segment* seg,
-                                 int steps, NV_PRIVATE float* t_hit, NV_PRIVATE uint* status) {
-  march_iter it = march_begin(m, GRID_ARG, seg, steps);
+static inline int lobe_first_hit(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg,
+                                 int steps, NV_PRIVATE float* t_hit) {
+  NV_PRIVATE uint* status = &ctx->status;
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, steps);
   *status |= it.status;
   float t, lo = seg->t0;
-  while (march_next(&it, GRID_ARG, &t)) {
-    const float rho = grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t));
+  while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
+    const float rho = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t));
     if (!(rho > 0.0f)) {
       if (rho != rho) *status |= STATUS_NAN; /* a NaN density must not pass as empty space */
       lo = t;
       continue;
     }
     lo = nv_fmax(lo, it.a); /* before its occupied piece the density is 0 */
-    if (grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, lo)) > 0.0f) {
+    if (grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, lo)) > 0.0f) {
       *t_hit = lo;
       return 1;
     }
@@ -140,7 +141,7 @@ static inline int lobe_first_hit(NV_CONSTANT const medium_params* m, GRID_PARAM,
     float hi = t;
     for (int b = 0; b < LOBE_BISECTIONS; ++b) {
       const float mid = 0.5f * (lo + hi);
-      if (grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, mid)) > 0.0f)
+      if (grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, mid)) > 0.0f)
         hi = mid;
       else
         lo = mid;
@@ -153,25 +154,27 @@ static inline int lobe_first_hit(NV_CONSTANT const medium_params* m, GRID_PARAM,
 
 /* Transmittance along the straight segment a → b (1 when they coincide), its march stopped once
  * its optical depth exceeds tau_limit in every channel (NV_INFINITY: never). */
-static inline vec3 lobe_transmittance_between(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 a, vec3 b,
-                                              int steps, float tau_limit, NV_PRIVATE uint* status) {
+static inline vec3 lobe_transmittance_between(KERNEL_CONTEXT_PARAM, vec3 a, vec3 b,
+                                              int steps, float tau_limit) {
+  NV_PRIVATE uint* status = &ctx->status;
   const vec3 ab = vec3_sub(b, a);
   const float dist = vec3_length(ab);
   if (!(dist > 0.0f)) {
     if (dist != dist) *status |= STATUS_NAN; /* a NaN point, not a coincident one */
     return vec3_splat(1.0f);
   }
-  return vec3_exp_neg(march_optical_depth_limited(m, GRID_ARG, a, vec3_scale(ab, 1.0f / dist), dist, steps, tau_limit,
-                                                  status));
+  return vec3_exp_neg(march_optical_depth_limited(KERNEL_CONTEXT_ARG, a, vec3_scale(ab, 1.0f / dist), dist, steps,
+                                                  tau_limit));
 }
 
 /* Adds to *in_sum the light of every light at lobe point P scattered towards c (direction −d, d the
  * lobe direction that placed P): Σ_k p(cos θ) · Tr(P → light_k) · I_k / |light_k − P|². Terms are
  * added light by light into *in_sum, the order Eq. 7's pixels were recorded with. */
-static inline void lobe_add_inscattered(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                        GRID_PARAM, NV_CONSTANT const realtime_params* p,
-                                        NV_GLOBAL const float* light_cache, vec3 P, vec3 d, NV_PRIVATE vec3* in_sum,
-                                        NV_PRIVATE uint* status) {
+static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* p,
+                                        NV_GLOBAL const float* light_cache, vec3 P, vec3 d, NV_PRIVATE vec3* in_sum) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
+  NV_PRIVATE uint* status = &ctx->status;
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 w_out = vec3_scale(d, -1.0f); /* from P towards c */
   for (int k = 0; k < s->num_lights; ++k) {
@@ -179,7 +182,7 @@ static inline void lobe_add_inscattered(NV_CONSTANT const scene_params* s, NV_CO
     float dist;
     if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
     const vec3 tr =
-        vec3_exp_neg(light_cache_optical_depth(m, GRID_ARG, p, light_cache, lights, k, P, to_light, dist, status));
+        vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, p, light_cache, k, P, to_light, dist));
     if (p->area_light_samples > 1) { /* rectangles as K×K points (march_light_phase_sum) */
       *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase_sum(&lights[k], P, m->phase, m->g, d,
                                                                       p->area_light_samples)));
@@ -209,14 +212,15 @@ static inline vec3 lobe_direction(vec3 tx, vec3 ty, vec3 dir, nv_float4 q) {
 }
 
 /* Eq. 7 (header comment, steps 1-4), bit for bit as the dissertation's reproduction records it. */
-static inline vec3 lobe_radiance_eq7(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                     GRID_PARAM, NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
+static inline vec3 lobe_radiance_eq7(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* p,
+                                     NV_GLOBAL const nv_float4* dirs,
                                      NV_GLOBAL const float* light_cache, vec3 origin, vec3 dir, vec3 tx, vec3 ty,
-                                     vec3 Lb, NV_PRIVATE const medium_segment* seg, NV_PRIVATE uint* status) {
+                                     vec3 Lb, NV_PRIVATE const medium_segment* seg) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const medium_params* m = &s->medium;
   /* 1. First hit. */
   float t_x0;
-  if (!lobe_first_hit(m, GRID_ARG, seg, p->steps, &t_x0, status)) return Lb;
+  if (!lobe_first_hit(KERNEL_CONTEXT_ARG, seg, p->steps, &t_x0)) return Lb;
   const vec3 x0 = vec3_madd(origin, dir, t_x0);
 
   /* 2. Lobe centre, depth clamped to the rest of the segment inside the box. */
@@ -236,8 +240,8 @@ static inline vec3 lobe_radiance_eq7(NV_CONSTANT const scene_params* s, NV_CONST
     const vec3 d = lobe_direction(tx, ty, dir, dirs[i]);
     const vec3 P = vec3_madd(c, d, p->lobe_radius);
     if (view_term)
-      tr_sum = vec3_add(tr_sum, lobe_transmittance_between(m, GRID_ARG, x0, P, p->view_steps, tau_limit, status));
-    lobe_add_inscattered(s, lights, GRID_ARG, p, light_cache, P, d, &in_sum, status);
+      tr_sum = vec3_add(tr_sum, lobe_transmittance_between(KERNEL_CONTEXT_ARG, x0, P, p->view_steps, tau_limit));
+    lobe_add_inscattered(KERNEL_CONTEXT_ARG, p, light_cache, P, d, &in_sum);
   }
   const float fn = (float)n;
   const vec3 tr_mean = vec3_make(tr_sum.x / fn, tr_sum.y / fn, tr_sum.z / fn);
@@ -246,11 +250,12 @@ static inline vec3 lobe_radiance_eq7(NV_CONSTANT const scene_params* s, NV_CONST
 }
 
 /* The corrected estimator (header comment, "Corrected"). */
-static inline vec3 lobe_radiance_corrected(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                           GRID_PARAM, NV_CONSTANT const realtime_params* p,
+static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* p,
                                            NV_GLOBAL const nv_float4* dirs, NV_GLOBAL const float* light_cache,
                                            vec3 origin, vec3 dir, vec3 tx, vec3 ty, vec3 Lb,
-                                           NV_PRIVATE const medium_segment* seg, NV_PRIVATE uint* status) {
+                                           NV_PRIVATE const medium_segment* seg) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_PRIVATE uint* status = &ctx->status;
   NV_CONSTANT const medium_params* m = &s->medium;
   /* C1-C2. One march of the view ray: its transmittance T_v and where its light is scattered,
    * t_c = Σ w_k S_k t_k / Σ w_k S_k with w_k = T(before k)·(1 − e^{−σ̄t,k Δ}) (channel means) and
@@ -258,15 +263,15 @@ static inline vec3 lobe_radiance_corrected(NV_CONSTANT const scene_params* s, NV
   const float tau_limit = p->min_transmittance > 0.0f
                               ? -nv_log(p->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
                               : NV_INFINITY;
-  march_iter it = march_begin(m, GRID_ARG, seg, p->view_steps);
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, p->view_steps);
   *status |= it.status;
   vec3 tau = vec3_splat(0.0f);
   float w_sum = 0.0f, wt_sum = 0.0f, ws_sum = 0.0f, wst_sum = 0.0f, t;
-  while (march_next(&it, GRID_ARG, &t)) {
-    const vec3 dtau = vec3_scale(march_sigma_t(m, GRID_ARG, seg, t), it.delta);
+  while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
+    const vec3 dtau = vec3_scale(march_sigma_t(KERNEL_CONTEXT_ARG, seg, t), it.delta);
     const float w = nv_exp(-vec3_average(tau)) * (1.0f - nv_exp(-vec3_average(dtau)));
     vec3 S = vec3_splat(0.0f);
-    if (w > 0.0f) lobe_add_inscattered(s, lights, GRID_ARG, p, light_cache, vec3_madd(origin, dir, t), dir, &S, status);
+    if (w > 0.0f) lobe_add_inscattered(KERNEL_CONTEXT_ARG, p, light_cache, vec3_madd(origin, dir, t), dir, &S);
     const float ws = w * vec3_average(S);
     w_sum += w;
     wt_sum += w * t;
@@ -291,7 +296,7 @@ static inline vec3 lobe_radiance_corrected(NV_CONSTANT const scene_params* s, NV
     const vec3 d = lobe_direction(tx, ty, dir, dirs[i]);
     medium_segment inside;
     const float reach = medium_intersect(m, c, d, 0.0f, r, &inside) ? inside.t1 : 0.0f;
-    lobe_add_inscattered(s, lights, GRID_ARG, p, light_cache, vec3_madd(c, d, reach), d, &in_sum, status);
+    lobe_add_inscattered(KERNEL_CONTEXT_ARG, p, light_cache, vec3_madd(c, d, reach), d, &in_sum);
   }
   const float fn = (float)n;
   const vec3 in_mean = vec3_make(in_sum.x / fn, in_sum.y / fn, in_sum.z / fn);
@@ -303,10 +308,11 @@ static inline vec3 lobe_radiance_corrected(NV_CONSTANT const scene_params* s, NV
 /* Radiance of the view ray from `origin` along unit `dir`. `right` is the camera's unit right
  * vector (the lobe frame's reference, see the header comment); `dirs` holds p->lobe_points unit
  * directions about +Z. */
-static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                 GRID_PARAM, NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
-                                 NV_GLOBAL const float* light_cache, vec3 origin, vec3 dir, vec3 right,
-                                 NV_PRIVATE uint* status) {
+static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* p,
+                                 NV_GLOBAL const nv_float4* dirs,
+                                 NV_GLOBAL const float* light_cache, vec3 origin, vec3 dir, vec3 right) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
   /* L_b, and the view ray stops at the first rectangle it meets (rectangles are opaque). */
   const vec3 Lb = march_background(s, lights, origin, dir);
   if (!s->has_medium || p->lobe_points < 1) return Lb;
@@ -321,12 +327,12 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
   const vec3 ty = vec3_cross(dir, tx);
   const int corrected = p->lobe_variant == LOBE_CORRECTED; /* else LOBE_EQ7, the host's only other variant */
   const vec3 L = corrected
-                     ? lobe_radiance_corrected(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status)
-                     : lobe_radiance_eq7(s, lights, GRID_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg, status);
+                     ? lobe_radiance_corrected(KERNEL_CONTEXT_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg)
+                     : lobe_radiance_eq7(KERNEL_CONTEXT_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg);
 #ifdef EMISSION
   /* The medium's own light, marched with `steps` samples in both variants (the first-hit search's,
    * 60 by default): corrected's view march has view_steps = 16, which aliases a fire's flames. */
-  return vec3_add(L, march_emission(&s->medium, GRID_ARG, &seg, p->steps, p->min_transmittance, status));
+  return vec3_add(L, march_emission(KERNEL_CONTEXT_ARG, &seg, p->steps, p->min_transmittance));
 #else
   return L;
 #endif
@@ -334,14 +340,15 @@ static inline vec3 lobe_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT 
 
 /* The pixel (px, py): ray through its centre (deterministic, no jitter). Non-finite results are
  * reported in *status and replaced by 0. */
-static inline vec3 lobe_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights, GRID_PARAM,
+static inline vec3 lobe_pixel(KERNEL_CONTEXT_PARAM,
                               NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
-                              NV_GLOBAL const float* light_cache, int px, int py, NV_PRIVATE uint* status) {
+                              NV_GLOBAL const float* light_cache, int px, int py) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_PRIVATE uint* status = &ctx->status;
   NV_CONSTANT const camera_params* cam = &s->camera;
   const vec3 dir = lobe_view_dir(cam, (float)px + 0.5f, (float)py + 0.5f);
   const vec3 L =
-      lobe_radiance(s, lights, GRID_ARG, p, dirs, light_cache, vec3_from4(cam->position), dir, vec3_from4(cam->right),
-                    status);
+      lobe_radiance(KERNEL_CONTEXT_ARG, p, dirs, light_cache, vec3_from4(cam->position), dir, vec3_from4(cam->right));
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);

@@ -16,9 +16,10 @@
 #include "shared/phase.h"
 
 /* σt at world point o + t·d of a medium segment (index-space origin and direction in `seg`). */
-static inline vec3 march_sigma_t(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_PRIVATE const medium_segment* seg,
+static inline vec3 march_sigma_t(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg,
                                  float t) {
-  const float rho = grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t));
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  const float rho = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t));
   return vec3_scale(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)), rho);
 }
 
@@ -63,7 +64,8 @@ typedef struct march_iter {
 } march_iter;
 
 /* Next occupied piece of the walk into [*a, *b]; 0 when none is left. */
-static inline int march_next_piece(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRIVATE float* a, NV_PRIVATE float* b) {
+static inline int march_next_piece(NV_PRIVATE march_iter* it, KERNEL_CONTEXT_PARAM, NV_PRIVATE float* a,
+                                   NV_PRIVATE float* b) {
   float mx;
   if (it->whole) {
     if (!(it->dda.t < it->dda.t_end)) return 0;
@@ -77,8 +79,9 @@ static inline int march_next_piece(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRI
   return 0;
 }
 
-static inline march_iter march_begin(NV_CONSTANT const medium_params* m, GRID_PARAM,
+static inline march_iter march_begin(KERNEL_CONTEXT_PARAM,
                                      NV_PRIVATE const medium_segment* seg, int steps) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
   march_iter it;
   it.whole = GRID_MAJORANTS == 0;
   it.dda = majorant_iter_begin(m->majorant_grid, seg->o, seg->d, seg->t0, seg->t1);
@@ -89,7 +92,7 @@ static inline march_iter march_begin(NV_CONSTANT const medium_params* m, GRID_PA
   /* First walk: the occupied length. */
   march_iter probe = it;
   float a, b, len = 0.0f;
-  while (march_next_piece(&probe, GRID_ARG, &a, &b)) len += b - a;
+  while (march_next_piece(&probe, KERNEL_CONTEXT_ARG, &a, &b)) len += b - a;
   it.status = probe.dda.status;
   it.a = it.b = it.s_a = 0.0f;
   it.steps = steps > 0 ? steps : 1;
@@ -99,13 +102,13 @@ static inline march_iter march_begin(NV_CONSTANT const medium_params* m, GRID_PA
 }
 
 /* The next sample's t (each sample stands for it->delta of path); 0 when all are placed. */
-static inline int march_next(NV_PRIVATE march_iter* it, GRID_PARAM, NV_PRIVATE float* t) {
+static inline int march_next(NV_PRIVATE march_iter* it, KERNEL_CONTEXT_PARAM, NV_PRIVATE float* t) {
   if (it->k >= it->steps || !(it->delta > 0.0f)) return 0;
   const float s = ((float)it->k + 0.5f) * it->delta;
   while (!(s < it->s_a + (it->b - it->a))) {
     float a, b;
     it->s_a += it->b - it->a;
-    if (!march_next_piece(it, GRID_ARG, &a, &b)) return 0;
+    if (!march_next_piece(it, KERNEL_CONTEXT_ARG, &a, &b)) return 0;
     it->a = a;
     it->b = b;
   }
@@ -131,43 +134,48 @@ static inline int march_clip(NV_CONSTANT const medium_params* m, vec3 origin, ve
  * then the sum is the full one, bit for bit): a view transmittance that is already below
  * e^{−tau_limit} in every channel can only fall further, so what it returns is at most that and at
  * least the true value (lobe.h derives what this costs a pixel). */
-static inline vec3 march_optical_depth_limited(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
-                                               float dist, int steps, float tau_limit, NV_PRIVATE uint* status) {
+static inline vec3 march_optical_depth_limited(KERNEL_CONTEXT_PARAM, vec3 origin, vec3 dir,
+                                               float dist, int steps, float tau_limit) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  NV_PRIVATE uint* status = &ctx->status;
   medium_segment seg;
   if (!march_clip(m, origin, dir, dist, &seg, status)) return vec3_splat(0.0f);
-  march_iter it = march_begin(m, GRID_ARG, &seg, steps);
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, steps);
   const float sum_limit = tau_limit / it.delta; /* on Σσt, before the scaling by Δ */
   vec3 tau = vec3_splat(0.0f);
   float t;
-  while (march_next(&it, GRID_ARG, &t)) {
-    tau = vec3_add(tau, march_sigma_t(m, GRID_ARG, &seg, t));
+  while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
+    tau = vec3_add(tau, march_sigma_t(KERNEL_CONTEXT_ARG, &seg, t));
     if (nv_fmin(tau.x, nv_fmin(tau.y, tau.z)) > sum_limit) break;
   }
   *status |= it.status;
   return vec3_scale(tau, it.delta);
 }
 
-static inline vec3 march_optical_depth(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
-                                       float dist, int steps, NV_PRIVATE uint* status) {
-  return march_optical_depth_limited(m, GRID_ARG, origin, dir, dist, steps, NV_INFINITY, status);
+static inline vec3 march_optical_depth(KERNEL_CONTEXT_PARAM, vec3 origin, vec3 dir,
+                                       float dist, int steps) {
+  return march_optical_depth_limited(KERNEL_CONTEXT_ARG, origin, dir, dist, steps, NV_INFINITY);
 }
 
 /* Transmittance exp(−τ) over the same quadrature (1 outside the box). */
-static inline vec3 march_transmittance(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
-                                       float dist, int steps, NV_PRIVATE uint* status) {
-  return vec3_exp_neg(march_optical_depth(m, GRID_ARG, origin, dir, dist, steps, status));
+static inline vec3 march_transmittance(KERNEL_CONTEXT_PARAM, vec3 origin, vec3 dir,
+                                       float dist, int steps) {
+  return vec3_exp_neg(march_optical_depth(KERNEL_CONTEXT_ARG, origin, dir, dist, steps));
 }
 
 /* Column density ∫ρ ds over the same quadrature as march_optical_depth (Σ ρ·Δ): the medium's σt
  * is σt_unit·ρ with one σt_unit per channel, so τ = σt_unit·column for every channel at once; the
  * light-transmittance cache (light_cache.h) stores this one float per node. */
-static inline float march_column_density(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 origin, vec3 dir,
-                                         float dist, int steps, NV_PRIVATE uint* status) {
+static inline float march_column_density(KERNEL_CONTEXT_PARAM, vec3 origin, vec3 dir,
+                                         float dist, int steps) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  NV_PRIVATE uint* status = &ctx->status;
   medium_segment seg;
   if (!march_clip(m, origin, dir, dist, &seg, status)) return 0.0f;
-  march_iter it = march_begin(m, GRID_ARG, &seg, steps);
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, steps);
   float column = 0.0f, t;
-  while (march_next(&it, GRID_ARG, &t)) column += grid_density(GRID_ARG, vec3_madd(seg.o, seg.d, t));
+  while (march_next(&it, KERNEL_CONTEXT_ARG, &t))
+    column += grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg.o, seg.d, t));
   *status |= it.status;
   return column * it.delta;
 }
@@ -180,20 +188,23 @@ static inline float march_column_density(NV_CONSTANT const medium_params* m, GRI
  * t_stop (0: never): what the rest would add is at most T·max(σa·Le/σt) < t_stop·max Le. For the
  * Lobe Estimator, whose estimate of the lights' light holds none; the ray marcher adds σa·Le inside
  * its own march. */
-static inline vec3 march_emission(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_PRIVATE const medium_segment* seg,
-                                  int steps, float t_stop, NV_PRIVATE uint* status) {
+static inline vec3 march_emission(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg,
+                                  int steps, float t_stop) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  NV_PRIVATE uint* status = &ctx->status;
   const vec3 st_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
-  march_iter it = march_begin(m, GRID_ARG, seg, steps);
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, steps);
   vec3 L = vec3_splat(0.0f), T = vec3_splat(1.0f);
   float t;
-  while (march_next(&it, GRID_ARG, &t)) {
+  while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
     const vec3 p = vec3_madd(seg->o, seg->d, t);
-    const float rho = grid_density(GRID_ARG, p);
+    const float rho = grid_density(KERNEL_CONTEXT_ARG, p);
     if (!(rho > 0.0f)) { /* nothing emits or attenuates there */
       if (rho != rho) *status |= STATUS_NAN;
       continue;
     }
-    march_energy_conserving_step(&L, &T, emission_source(m, GRID_ARG, p, rho), vec3_scale(st_unit, rho), it.delta);
+    march_energy_conserving_step(&L, &T, emission_source(KERNEL_CONTEXT_ARG, p, rho), vec3_scale(st_unit, rho),
+                                 it.delta);
     if (vec3_max_component(T) < t_stop) break;
   }
   *status |= it.status;
@@ -291,8 +302,10 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
  * through a dense cloud the centre alone makes the light's soft shadow hard and dark. With one σt
  * for all channels (a grey medium) σt_unit·C gives each channel's averaged transmittance exactly;
  * for a coloured one it is the average for the mean σt. */
-static inline float march_light_column(NV_CONSTANT const medium_params* m, GRID_PARAM, NV_CONSTANT const light_params* l,
-                                       vec3 x, int K, int shadow_steps, NV_PRIVATE uint* status) {
+static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const light_params* l,
+                                       vec3 x, int K, int shadow_steps) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  NV_PRIVATE uint* status = &ctx->status;
   int area = 0; /* a rectangle's K×K points, else the light's one point */
   switch (LIGHT_KIND(l)) {
     case LIGHT_RECTANGLE: area = K > 1; break;
@@ -313,7 +326,7 @@ static inline float march_light_column(NV_CONSTANT const medium_params* m, GRID_
       }
       const float d = nv_sqrt(d2);
       const vec3 dir = vec3_scale(to, 1.0f / d);
-      const float column = march_column_density(m, GRID_ARG, x, dir, d, shadow_steps, status);
+      const float column = march_column_density(KERNEL_CONTEXT_ARG, x, dir, d, shadow_steps);
       if (!area) return column;
       const float cos_l = -vec3_dot(dir, n);
       if (!(cos_l > 0.0f)) continue;

@@ -22,9 +22,10 @@
 
 /* Transmittance from x to the light point at distance `dist` along unit dir: 0 if another
  * rectangle is in the way, else ratio tracking through the medium. */
-static inline vec3 pathtrace_shadow(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                    GRID_PARAM, int light_index, vec3 x, vec3 dir, float dist,
-                                    NV_PRIVATE rng_state* rng, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+static inline vec3 pathtrace_shadow(KERNEL_CONTEXT_PARAM, int light_index, vec3 x, vec3 dir, float dist,
+                                    NV_PRIVATE rng_state* rng) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
   float t_block;
   int front;
   if (intersect_lights(lights, s->num_lights, x, dir, 0.0f, light_index, &t_block, &front) >= 0 &&
@@ -32,13 +33,14 @@ static inline vec3 pathtrace_shadow(NV_CONSTANT const scene_params* s, NV_CONSTA
     return vec3_splat(0.0f);
   medium_segment seg;
   if (!s->has_medium || !medium_intersect(&s->medium, x, dir, 0.0f, dist, &seg)) return vec3_splat(1.0f);
-  return tracking_ratio(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, rng, status TRACK_COUNTERS_ARG);
+  return tracking_ratio(KERNEL_CONTEXT_ARG, seg.o, seg.d, seg.t0, seg.t1, rng);
 }
 
 /* Direct light at a scattering point x for a path arriving along w_in, summed over all lights. */
-static inline vec3 pathtrace_direct(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                    GRID_PARAM, vec3 x, vec3 w_in, NV_PRIVATE rng_state* rng,
-                                    NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+static inline vec3 pathtrace_direct(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, NV_PRIVATE rng_state* rng) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
+  NV_PRIVATE uint* status = &ctx->status;
   vec3 sum = vec3_splat(0.0f);
   for (int i = 0; i < s->num_lights; ++i) {
     const float u1 = rng_uniform(rng), u2 = rng_uniform(rng);
@@ -49,7 +51,7 @@ static inline vec3 pathtrace_direct(NV_CONSTANT const scene_params* s, NV_CONSTA
       if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
       continue;
     }
-    const vec3 tr = pathtrace_shadow(s, lights, GRID_ARG, i, x, ls.dir, ls.dist, rng, status TRACK_COUNTERS_ARG);
+    const vec3 tr = pathtrace_shadow(KERNEL_CONTEXT_ARG, i, x, ls.dir, ls.dist, rng);
     if (vec3_is_zero(tr)) continue;
     /* Point light: Le·f·Tr·I/d². Rectangle: Le·f·Tr/pdf_light weighted against phase sampling,
      * whose pdf is f (sampling is exact). */
@@ -64,9 +66,11 @@ static inline vec3 pathtrace_direct(NV_CONSTANT const scene_params* s, NV_CONSTA
  * unscattered light of the lights, which the ray marcher adds itself: the multiple-scattering
  * cache, ms_cache.h); the background seen through the medium is kept either way. Non-finite
  * results are left to the caller's check. */
-static inline vec3 pathtrace_radiance(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                      GRID_PARAM, vec3 o, vec3 d, int unscattered_emitters, NV_PRIVATE rng_state* rng_in,
-                                      NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+static inline vec3 pathtrace_radiance(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, int unscattered_emitters,
+                                      NV_PRIVATE rng_state* rng_in) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
+  NV_PRIVATE uint* status = &ctx->status;
   rng_state rng = *rng_in;
   vec3 L = vec3_splat(0.0f), beta = vec3_splat(1.0f);
   float prev_phase_pdf = 0.0f; /* 0: the ray left the camera, no MIS on what it hits */
@@ -82,14 +86,14 @@ static inline vec3 pathtrace_radiance(NV_CONSTANT const scene_params* s, NV_CONS
     medium_segment seg;
     if (s->has_medium && medium_intersect(&s->medium, o, d, 0.0f, t_surf, &seg)) {
       float t_hit;
-      const int event = tracking_delta(&s->medium, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit,
-                                       status TRACK_EMISSION_ARG(&L) TRACK_COUNTERS_ARG);
+      const int event = tracking_delta(KERNEL_CONTEXT_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta,
+                                       &t_hit TRACK_EMISSION_ARG(&L));
       if (event == TRACK_ABSORBED) break;
       if (event == TRACK_SCATTERED) {
         if (depth >= s->max_bounces) break;
         ++depth;
         const vec3 x = vec3_madd(o, d, t_hit);
-        L = vec3_add(L, vec3_mul(beta, pathtrace_direct(s, lights, GRID_ARG, x, d, &rng, status TRACK_COUNTERS_ARG)));
+        L = vec3_add(L, vec3_mul(beta, pathtrace_direct(KERNEL_CONTEXT_ARG, x, d, &rng)));
         const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
         float pdf;
         d = phase_sample(s->medium.phase, s->medium.g, d, u1, u2, &pdf);
@@ -119,14 +123,15 @@ static inline vec3 pathtrace_radiance(NV_CONSTANT const scene_params* s, NV_CONS
   return L;
 }
 
-static inline vec3 pathtrace_sample(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                    GRID_PARAM, int px, int py, uint sample, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+static inline vec3 pathtrace_sample(KERNEL_CONTEXT_PARAM, int px, int py, uint sample) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_PRIVATE uint* status = &ctx->status;
   const uint pixel = (uint)py * (uint)s->camera.width + (uint)px;
   rng_state rng = rng_init(s->seed, pixel, sample);
   const float jx = rng_uniform(&rng), jy = rng_uniform(&rng);
   const float lu = rng_uniform(&rng), lv = rng_uniform(&rng);
   const ray3 cam = camera_ray(&s->camera, (float)px + jx, (float)py + jy, lu, lv);
-  const vec3 L = pathtrace_radiance(s, lights, GRID_ARG, cam.origin, cam.dir, 1, &rng, status TRACK_COUNTERS_ARG);
+  const vec3 L = pathtrace_radiance(KERNEL_CONTEXT_ARG, cam.origin, cam.dir, 1, &rng);
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);

@@ -80,17 +80,17 @@
 
 /* Light arriving at x and scattered towards the camera, per unit σs: Σ_lights (I/d²) ⊙
  * Σ_{i<N} aⁱ p(g cⁱ, μ) exp(−bⁱ τ). view_dir points away from the camera. */
-static inline vec3 raymarch_light_sum(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                      GRID_PARAM, NV_CONSTANT const realtime_params* rp,
-                                      NV_GLOBAL const float* light_cache, vec3 x, vec3 view_dir,
-                                      NV_PRIVATE uint* status) {
+static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp,
+                                      NV_GLOBAL const float* light_cache, vec3 x, vec3 view_dir) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
   NV_CONSTANT const medium_params* m = &s->medium;
   vec3 sum = vec3_splat(0.0f);
   for (int l = 0; l < s->num_lights; ++l) {
     vec3 dir, I;
     float dist;
     if (!march_light_as_point(&lights[l], x, &dir, &dist, &I)) continue;
-    const vec3 tau = light_cache_optical_depth(m, GRID_ARG, rp, light_cache, lights, l, x, dir, dist, status);
+    const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, rp, light_cache, l, x, dir, dist);
     if (rp->area_light_samples > 1) {
       /* Rectangles as K×K points (march_light_phase_sum), shadowed towards their centre. */
       const int K = rp->area_light_samples;
@@ -136,18 +136,19 @@ typedef struct raymarch_accum {
  * Loops: `steps` samples (march_next, its piece walk capped by the DDA budget), each
  * with num_lights shadow marches of shadow_steps samples and `octaves` (≤ 16) terms: all bounded by
  * the scene's own parameters, no cap of their own. */
-static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                    GRID_PARAM, NV_CONSTANT const realtime_params* rp,
+static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp,
                                     NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache,
                                     NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, int steps,
-                                    float t_stop, NV_PRIVATE raymarch_accum* acc, NV_PRIVATE uint* status) {
+                                    float t_stop, NV_PRIVATE raymarch_accum* acc) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_PRIVATE uint* status = &ctx->status;
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
-  march_iter it = march_begin(m, GRID_ARG, seg, steps);
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, steps);
   const float dt = it.delta;
   float t;
-  while (march_next(&it, GRID_ARG, &t)) {
-    const float rho = grid_density(GRID_ARG, vec3_madd(seg->o, seg->d, t));
+  while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
+    const float rho = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t));
     if (!(rho > 0.0f)) { /* S = 0 and e^{−0} = 1: the step would change nothing */
       if (rho != rho) *status |= STATUS_NAN; /* a NaN density must not pass as empty space */
       continue;
@@ -156,14 +157,14 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
     const vec3 sigma_s = vec3_scale(ss, rho);
     vec3 S = vec3_splat(0.0f);
     if (!vec3_is_zero(sigma_s)) {
-      vec3 Li = raymarch_light_sum(s, lights, GRID_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir, status);
+      vec3 Li = raymarch_light_sum(KERNEL_CONTEXT_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir);
       if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h) */
         Li = vec3_add(Li, ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), vec3_madd(seg->o, seg->d, t),
                                           phase_mean_cosine(m->phase, m->g), vec3_scale(dir, -1.0f)));
       S = vec3_mul(sigma_s, Li);
     }
 #ifdef EMISSION
-    S = vec3_add(S, emission_source(m, GRID_ARG, vec3_madd(seg->o, seg->d, t), rho)); /* σa·Le (emission.h) */
+    S = vec3_add(S, emission_source(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t), rho)); /* σa·Le (emission.h) */
 #endif
     march_energy_conserving_step(&acc->L, &acc->T, S, sigma_t, dt);
     if (vec3_max_component(acc->T) < t_stop) break; /* early termination (above) */
@@ -172,10 +173,11 @@ static inline void raymarch_segment(NV_CONSTANT const scene_params* s, NV_CONSTA
 }
 
 /* Radiance through the centre of pixel (px, py). Pinhole: the ray leaves the lens centre. */
-static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                  GRID_PARAM, NV_CONSTANT const realtime_params* rp,
-                                  NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache, int px, int py,
-                                  NV_PRIVATE uint* status) {
+static inline vec3 raymarch_pixel(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp,
+                                  NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache, int px, int py) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
+  NV_PRIVATE uint* status = &ctx->status;
   const ray3 r = camera_ray(&s->camera, (float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f);
   const vec3 Lb = march_background(s, lights, r.origin, r.dir);
   vec3 L = Lb;
@@ -190,8 +192,7 @@ static inline vec3 raymarch_pixel(NV_CONSTANT const scene_params* s, NV_CONSTANT
       acc.L = vec3_splat(0.0f);
       acc.T = vec3_splat(1.0f);
       const float t_stop = rp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb));
-      raymarch_segment(s, lights, GRID_ARG, rp, light_cache, ms_cache, &seg, r.origin, r.dir, rp->steps, t_stop, &acc,
-                       status);
+      raymarch_segment(KERNEL_CONTEXT_ARG, rp, light_cache, ms_cache, &seg, r.origin, r.dir, rp->steps, t_stop, &acc);
       L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
     }
   }

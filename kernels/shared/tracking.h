@@ -13,7 +13,7 @@
 #define NARVAL_TRACKING_H
 
 #include "shared/emission.h"
-#include "shared/grid.h"
+#include "shared/kernel_context.h"
 #include "shared/majorant.h"
 #include "shared/rng.h"
 #include "shared/sampling.h"
@@ -101,26 +101,8 @@
 #define TRACKING_GREY(m) ((m)->grey)
 #endif
 
-/* Counters (-DCOUNTERS): per work-item counts of tentative (delta/spectral tracking) and real
- * (absorbing or scattering) collisions and of density lookups (both walks), in private 64-bit
- * integers; the kernel adds them to per-pixel slots of its own (pathtrace.cl), the host sums those:
- * no atomics, no floats, no overflow (2^64). Without COUNTERS the parameter and every count vanish
- * from the source. Every delta-tracking tentative collision reads the density once, so
- * lookups − tentative = the ratio-tracking lookups of the shadow rays. */
-typedef struct track_counters {
-  nv_ulong tentative;
-  nv_ulong real;
-  nv_ulong lookups;
-} track_counters;
-#ifdef COUNTERS
-#define TRACK_COUNTERS_PARAM , NV_PRIVATE track_counters* counters
-#define TRACK_COUNTERS_ARG , counters
-#define TRACK_COUNT(field) (counters->field += 1u)
-#else
-#define TRACK_COUNTERS_PARAM
-#define TRACK_COUNTERS_ARG
-#define TRACK_COUNT(field) ((void)0)
-#endif
+/* Counters (-DCOUNTERS): tentative and real collisions and density lookups, counted into the
+ * context's track_counters (kernel_context.h) by TRACK_COUNT. */
 
 /* Emission (-DEMISSION, emission.h): tracking_delta also collects the medium's own light into
  * *emitted, pbrt-v4's estimator: at every tentative collision t_i (null or real, before its event
@@ -200,10 +182,10 @@ static inline int tracking_walk_step(NV_PRIVATE tracking_walk* w, NV_GLOBAL cons
 /* Walks o + t·d (index-space origin and direction; t is the world-space ray parameter because d is
  * the world direction mapped by the same affine map) from t to t_max. On TRACK_SCATTERED, *t_out
  * is the collision and *beta has been reweighted (chromatic media only). */
-static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 o, vec3 d, float t,
-                                 float t_max, NV_PRIVATE rng_state* rng, NV_PRIVATE vec3* beta,
-                                 NV_PRIVATE float* t_out, NV_PRIVATE uint* status TRACK_EMISSION_PARAM
-                                 TRACK_COUNTERS_PARAM) {
+static inline int tracking_delta(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, float t_max, NV_PRIVATE rng_state* rng,
+                                 NV_PRIVATE vec3* beta, NV_PRIVATE float* t_out TRACK_EMISSION_PARAM) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  NV_PRIVATE uint* status = &ctx->status;
   if (!(m->majorant < NV_INFINITY)) { /* NaN or +inf */
     *status |= STATUS_NAN;
     return TRACK_ABSORBED;
@@ -219,10 +201,10 @@ static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM,
     TRACK_COUNT(tentative);
     TRACK_COUNT(lookups);
     const vec3 x_index = vec3_madd(o, d, w.t);
-    const float rho = grid_density(GRID_ARG, x_index);
+    const float rho = grid_density(KERNEL_CONTEXT_ARG, x_index);
 #ifdef EMISSION
     if (rho > 0.0f) /* β ⊙ σa·Le/σ̄ at every tentative collision (above) */
-      *emitted = vec3_add(*emitted, vec3_scale(vec3_mul(*beta, emission_source(m, GRID_ARG, x_index, rho)),
+      *emitted = vec3_add(*emitted, vec3_scale(vec3_mul(*beta, emission_source(KERNEL_CONTEXT_ARG, x_index, rho)),
                                                1.0f / sigma_bar));
 #endif
     const float u = rng_uniform(rng);
@@ -277,8 +259,10 @@ static inline int tracking_delta(NV_CONSTANT const medium_params* m, GRID_PARAM,
 }
 
 /* Ratio-tracking estimate of the transmittance along o + t·d over [t, t_max]. */
-static inline vec3 tracking_ratio(NV_CONSTANT const medium_params* m, GRID_PARAM, vec3 o, vec3 d, float t,
-                                  float t_max, NV_PRIVATE rng_state* rng, NV_PRIVATE uint* status TRACK_COUNTERS_PARAM) {
+static inline vec3 tracking_ratio(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, float t_max,
+                                  NV_PRIVATE rng_state* rng) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  NV_PRIVATE uint* status = &ctx->status;
   vec3 tr = vec3_splat(1.0f);
   if (!(m->majorant < NV_INFINITY)) { /* NaN or +inf, see tracking_delta */
     *status |= STATUS_NAN;
@@ -287,13 +271,13 @@ static inline vec3 tracking_ratio(NV_CONSTANT const medium_params* m, GRID_PARAM
   if (!(m->majorant > 0.0f)) return tr;
   const vec3 st = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
   /* A homogeneous medium has the closed form: Beer-Lambert, no variance. */
-  if (GRID_IS_HOMOGENEOUS(GRID_ARG)) return vec3_exp_neg(vec3_scale(st, nv_fmax(0.0f, t_max - t)));
+  if (GRID_IS_HOMOGENEOUS_CTX(ctx)) return vec3_exp_neg(vec3_scale(st, nv_fmax(0.0f, t_max - t)));
   tracking_walk w = tracking_walk_begin(m, TRACKING_USE_MAJORANT_GRID(m), o, d, t, t_max);
   for (int step = 0; step < TRACKING_MAX_STEPS; ++step) {
     if (!tracking_walk_step(&w, GRID_MAJORANTS, sample_exponential(rng_uniform(rng), 1.0f), status)) return tr;
     const float inv_bar = 1.0f / w.bar;
     TRACK_COUNT(lookups);
-    const float rho = grid_density(GRID_ARG, vec3_madd(o, d, w.t));
+    const float rho = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(o, d, w.t));
     const vec3 wt = vec3_sub(vec3_splat(1.0f), vec3_scale(st, rho * inv_bar)); /* σn/σ̄ per channel */
     const float w_min = nv_fmin(wt.x, nv_fmin(wt.y, wt.z));
     if (!(w_min >= 0.0f)) {

@@ -3,19 +3,31 @@
 #include "shared/medium.h"
 #include "shared/tracking.h"
 
-__kernel void ratio_tracking_stats(__constant medium_params* m, GRID_PARAM, __global const float4* rays,
+/* The medium's context: the grid in the context, or (image storage) beside it. */
+#if GRID_STORAGE_IN_CONTEXT
+#define TEST_CONTEXT(ctx)                                   \
+  kernel_context ctx = kernel_context_of_medium(m, grid_majorants); \
+  ctx.grid = grid
+#define TEST_ARG(ctx) &ctx
+#else
+#define TEST_CONTEXT(ctx) kernel_context ctx = kernel_context_of_medium(m, grid_majorants)
+#define TEST_ARG(ctx) &ctx, grid, grid
+#endif
+
+__kernel void ratio_tracking_stats(__constant medium_params* m, GRID_STORAGE grid, __global const float* grid_majorants,
+                                   __global const float4* rays,
                                    uint n, __global float* out_mean, __global float* out_var,
                                    __global uint* status_word) {
   const int i = get_global_id(0);
   const vec3 o = rays[2 * i].xyz;
   const vec3 d = rays[2 * i + 1].xyz;
-  uint status = 0u;
+  TEST_CONTEXT(ctx);
   medium_segment seg;
   float mean = 0.0f, m2 = 0.0f;
   if (medium_intersect(m, o, d, 0.0f, NV_INFINITY, &seg)) {
     for (uint s = 0u; s < n; ++s) {
       rng_state rng = rng_init(1234u, (uint)i, s);
-      const float tr = tracking_ratio(m, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &status).x;
+      const float tr = tracking_ratio(TEST_ARG(ctx), seg.o, seg.d, seg.t0, seg.t1, &rng).x;
       /* Welford's running mean and variance */
       const float delta = tr - mean;
       mean += delta / (float)(s + 1u);
@@ -26,17 +38,19 @@ __kernel void ratio_tracking_stats(__constant medium_params* m, GRID_PARAM, __gl
   }
   out_mean[i] = mean;
   out_var[i] = n > 1u ? m2 / (float)(n - 1u) : 0.0f;
-  if (status) atomic_or(status_word, status);
+  if (ctx.status) atomic_or(status_word, ctx.status);
 }
 
 /* Delta tracking on the same rays: the fraction of n walks (absorption-only view: any real
  * collision ends the walk) that escape the box, the free-flight estimate of the transmittance. */
-__kernel void delta_escape_fraction(__constant medium_params* m, GRID_PARAM, __global const float4* rays,
+__kernel void delta_escape_fraction(__constant medium_params* m, GRID_STORAGE grid,
+                                    __global const float* grid_majorants,
+                                    __global const float4* rays,
                                     uint n, __global float* out_fraction, __global uint* status_word) {
   const int i = get_global_id(0);
   const vec3 o = rays[2 * i].xyz;
   const vec3 d = rays[2 * i + 1].xyz;
-  uint status = 0u;
+  TEST_CONTEXT(ctx);
   medium_segment seg;
   uint escaped = n;
   if (medium_intersect(m, o, d, 0.0f, NV_INFINITY, &seg)) {
@@ -45,9 +59,9 @@ __kernel void delta_escape_fraction(__constant medium_params* m, GRID_PARAM, __g
       rng_state rng = rng_init(4321u, (uint)i, s);
       vec3 beta = vec3_splat(1.0f);
       float t_hit;
-      escaped += tracking_delta(m, GRID_ARG, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit, &status) == TRACK_ESCAPED;
+      escaped += tracking_delta(TEST_ARG(ctx), seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t_hit) == TRACK_ESCAPED;
     }
   }
   out_fraction[i] = (float)escaped / (float)n;
-  if (status) atomic_or(status_word, status);
+  if (ctx.status) atomic_or(status_word, ctx.status);
 }

@@ -26,6 +26,7 @@
 #include "shared/medium.h"
 #include "volume/brick_grid.h"
 #include "volume/grid.h"
+#include "unit/host_context.h"
 
 namespace narval {
 const std::map<std::string, std::string>& testKernelSources();
@@ -130,7 +131,7 @@ void checkRatioTracking(GridStorage storage, bool globalMajorant) {
     double tau = 0;
     for (int s = 0; s < steps; ++s) {
       const double t = seg.t0 + (s + 0.5) * (seg.t1 - seg.t0) / steps;
-      tau += sigmaT * grid_density(&gv, vec3_madd(seg.o, seg.d, float(t))) * (seg.t1 - seg.t0) / steps;
+      tau += sigmaT * grid_view_density(&gv, vec3_madd(seg.o, seg.d, float(t))) * (seg.t1 - seg.t0) / steps;
     }
     const double expected = std::exp(-tau);
     crossing += tau > 0.5;

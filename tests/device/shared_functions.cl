@@ -95,8 +95,9 @@ __kernel void sf_tracking_ratio(__constant medium_params* m, __global const floa
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   rng_state rng = rng_init(1u, i, 0u);
-  uint status = 0u;
-  const vec3 tr = tracking_ratio(m, 0, 0, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), in[2 * i], in[2 * i + 1], &rng, &status);
+  kernel_context ctx = kernel_context_of_medium(m, 0); /* homogeneous: one global majorant */
+  const vec3 tr = tracking_ratio(&ctx, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), in[2 * i],
+                                 in[2 * i + 1], &rng);
   out[3 * i + 0] = tr.x;
   out[3 * i + 1] = tr.y;
   out[3 * i + 2] = tr.z;
@@ -109,11 +110,11 @@ __kernel void sf_tracking_delta(__constant medium_params* m, __global const floa
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   rng_state rng = rng_init(seed, i, 0u);
-  uint status = 0u;
+  kernel_context ctx = kernel_context_of_medium(m, 0);
   vec3 beta = vec3_make(1.0f, 1.0f, 1.0f);
   float t = -1.0f;
-  const int e = tracking_delta(m, 0, 0, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), 0.0f, in[i], &rng, &beta,
-                               &t, &status);
+  const int e = tracking_delta(&ctx, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), 0.0f, in[i], &rng,
+                               &beta, &t);
   out[5 * i + 0] = (float)e;
   out[5 * i + 1] = t;
   out[5 * i + 2] = beta.x;

@@ -27,6 +27,7 @@
 #include "shared/rng.h"
 #include "shared/sampling.h"
 #include "shared/tracking.h"
+#include "unit/host_context.h"
 
 namespace narval {
 const std::map<std::string, std::string>& testKernelSources();
@@ -391,7 +392,8 @@ TEST_F(SharedOnDevice, TrackingRatioHomogeneous) {
   for (size_t i = 0; i < n; ++i) {
     rng_state rng = rng_init(1u, static_cast<uint>(i), 0u);
     uint status = 0u;
-    const vec3 tr = tracking_ratio(&m, &h, vec3_splat(0.0f), vec3_make(0, 0, 1), in[2 * i], in[2 * i + 1], &rng, &status);
+    const vec3 tr = tracking_ratio(narval::test::hostContext(&m, &h, &status), vec3_splat(0.0f), vec3_make(0, 0, 1),
+                                   in[2 * i], in[2 * i + 1], &rng);
     diff.add(tr.x, dev[3 * i], 0.0f, at(i));
     diff.add(tr.y, dev[3 * i + 1], 0.0f, at(i));
     diff.add(tr.z, dev[3 * i + 2], 0.0f, at(i));
@@ -418,7 +420,8 @@ TEST_F(SharedOnDevice, TrackingDeltaChromaticHomogeneous) {
     uint status = 0u;
     vec3 b = vec3_splat(1.0f);
     float t = -1.0f;
-    const int e = tracking_delta(&m, &h, vec3_splat(0.0f), vec3_make(0, 0, 1), 0.0f, in[i], &rng, &b, &t, &status);
+    const int e = tracking_delta(narval::test::hostContext(&m, &h, &status), vec3_splat(0.0f), vec3_make(0, 0, 1),
+                                 0.0f, in[i], &rng, &b, &t);
     if (static_cast<float>(e) != dev[5 * i]) {
       ++eventMismatches;
       continue;

@@ -15,6 +15,7 @@
 #include "render_fixture.h"
 #include "shared/grid.h"
 #include "volume/grid.h"
+#include "unit/host_context.h"
 
 namespace narval::test {
 namespace {
@@ -438,7 +439,7 @@ double voxelTransmittance(const DenseGrid& g, const nv_affine& m, const Ray& r) 
     p.x = float(q.o[0] + t * q.d[0]);
     p.y = float(q.o[1] + t * q.d[1]);
     p.z = float(q.o[2] + t * q.d[2]);
-    tau += grid_density(&view, p) * dt;
+    tau += grid_view_density(&view, p) * dt;
   }
   return std::exp(-kVoxelSigma * tau);
 }

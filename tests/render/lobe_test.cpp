@@ -15,6 +15,7 @@
 #include "render_fixture.h"
 #include "shared/lobe.h"
 #include "volume/grid.h"
+#include "unit/host_context.h"
 
 namespace narval::test {
 namespace {
@@ -167,7 +168,8 @@ TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
       // tested on the host): same float algorithm, so agreement to float rounding.
       uint status = 0;
       const vec3 host =
-          lobe_pixel(&ds.params, ds.lights.data(), &homogeneous, &params, dirs.data(), nullptr, px, py, &status);
+          lobe_pixel(narval::test::sceneContext(&ds.params, ds.lights.data(), &homogeneous, &status), &params,
+                     dirs.data(), nullptr, px, py);
       EXPECT_EQ(status, 0u);
       const float hostRgb[3] = {host.x, host.y, host.z};
       for (int ch = 0; ch < 3; ++ch) {

@@ -16,6 +16,7 @@
 #include "render/scene_upload.h"
 #include "scene/scene.h"
 #include "shared/march.h"
+#include "unit/host_context.h"
 
 namespace narval::test {
 namespace {
@@ -115,7 +116,7 @@ TEST(AreaLight, PhaseSumAndColumnConvergeToTheIntegralsOverTheLight) {
       const double tol = K == 16 ? 0.005 : 0.05;
       const vec3 phase = march_light_phase_sum(&l, xf, m.phase, m.g, vf, K);
       EXPECT_NEAR(phase.x, ref.phase, tol * ref.phase) << "K " << K;
-      const float column = march_light_column(&m, &f.grid, &l, xf, K, 8, &status);
+      const float column = march_light_column(narval::test::hostContext(&m, &f.grid, &status), &l, xf, K, 8);
       EXPECT_NEAR(column, ref.column, tol * ref.column) << "K " << K;
     }
     // K = 1: the centre.
@@ -127,7 +128,8 @@ TEST(AreaLight, PhaseSumAndColumnConvergeToTheIntegralsOverTheLight) {
     EXPECT_NEAR(centre.x, point, 1e-5 * point);
     const D3 c = {l.corner.x + 0.5 * (l.edge_u.x + l.edge_v.x), l.corner.y + 0.5 * (l.edge_u.y + l.edge_v.y),
                   l.corner.z + 0.5 * (l.edge_u.z + l.edge_v.z)};
-    EXPECT_NEAR(march_light_column(&m, &f.grid, &l, xf, 1, 8, &status), chordInCube(x, c), 1e-5);
+    EXPECT_NEAR(march_light_column(narval::test::hostContext(&m, &f.grid, &status), &l, xf, 1, 8), chordInCube(x, c),
+                1e-5);
     EXPECT_EQ(status, 0u);
     worstK1 = std::max(worstK1, std::fabs(centre.x - ref.phase) / ref.phase);
   }
@@ -153,10 +155,10 @@ TEST(AreaLight, PointLightIgnoresK) {
   for (int K : {2, 7}) {
     EXPECT_EQ(march_light_phase_sum(&ds.lights[0], x, ds.params.medium.phase, 0.5f, view, K).x,
               march_light_phase_sum(&ds.lights[0], x, ds.params.medium.phase, 0.5f, view, 1).x);
-    EXPECT_EQ(march_light_column(&ds.params.medium, &grid, &ds.lights[0], x, K, 8, &status),
-              march_light_column(&ds.params.medium, &grid, &ds.lights[0], x, 1, 8, &status));
+    EXPECT_EQ(march_light_column(narval::test::hostContext(&ds.params.medium, &grid, &status), &ds.lights[0], x, K, 8),
+              march_light_column(narval::test::hostContext(&ds.params.medium, &grid, &status), &ds.lights[0], x, 1, 8));
   }
-  EXPECT_NEAR(march_light_column(&ds.params.medium, &grid, &ds.lights[0], x, 3, 8, &status),
+  EXPECT_NEAR(march_light_column(narval::test::hostContext(&ds.params.medium, &grid, &status), &ds.lights[0], x, 3, 8),
               chordInCube({0.1, -0.2, 0.3}, {0.2, 1.5, -0.3}), 1e-5);
   EXPECT_EQ(status, 0u);
 }

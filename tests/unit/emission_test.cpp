@@ -24,6 +24,7 @@
 #include "render/scene_upload.h"
 #include "scene/scene.h"
 #include "test_support.h"
+#include "unit/host_context.h"
 
 namespace narval {
 namespace {
@@ -100,7 +101,8 @@ TEST_F(EmissionLookup, AnEmissionGridIsPlacedByItsOwnTransformAndBox) {
   double worst = 0;
   for (int i = 0; i < 2000; ++i) {
     const double p[3] = {u(rng), u(rng), u(rng)};
-    const vec3 Le = emission_radiance(&ds.params.medium, &view, vec3_make(float(p[0]), float(p[1]), float(p[2])));
+    const vec3 Le = emission_radiance(narval::test::hostContext(&ds.params.medium, &view),
+                                      vec3_make(float(p[0]), float(p[1]), float(p[2])));
     // Le = colour · scale · heat(world(p)); the heat grid is linear in world space, so trilinear
     // filtering at any point between its voxel centres gives it exactly (up to float rounding,
     // relative 1e-5 of values 10-640).
@@ -116,7 +118,7 @@ TEST_F(EmissionLookup, AnEmissionGridIsPlacedByItsOwnTransformAndBox) {
   const DeviceScene dsf = buildDeviceScene(f, loadSceneGrids(f, storage));
   const grid_view vf = viewOf(dsf);
   const double p[3] = {3.3, 4.1, 5.7};
-  EXPECT_NEAR(emission_radiance(&dsf.params.medium, &vf, vec3_make(3.3f, 4.1f, 5.7f)).y,
+  EXPECT_NEAR(emission_radiance(narval::test::hostContext(&dsf.params.medium, &vf), vec3_make(3.3f, 4.1f, 5.7f)).y,
               heatAt(fileWorld(storage.density, p)), 1e-5 * heatAt(fileWorld(storage.density, p)));
 }
 
@@ -140,7 +142,8 @@ TEST_F(EmissionLookup, BlackbodyFromATemperatureGrid) {
   double worst = 0;
   for (int i = 0; i < 2000; ++i) {
     const double p[3] = {u(rng), u(rng), u(rng)};
-    const vec3 Le = emission_radiance(&ds.params.medium, &view, vec3_make(float(p[0]), float(p[1]), float(p[2])));
+    const vec3 Le = emission_radiance(narval::test::hostContext(&ds.params.medium, &view),
+                                      vec3_make(float(p[0]), float(p[1]), float(p[2])));
     const double T = (heatAt(fileWorld(*grids.density, p)) - 200) * 20;
     if (T <= 100) {
       // Nothing at or below 100 K, exactly (emission_blackbody's rule, not the table's).

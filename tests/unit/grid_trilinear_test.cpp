@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "shared/grid.h"
+#include "unit/host_context.h"
 
 namespace {
 
@@ -139,7 +140,7 @@ TEST(GridTrilinear, HostGridDensityIsTheSharedFilter) {
   std::uniform_real_distribution<float> u(-1.0f, 6.0f);
   for (int n = 0; n < 1000; ++n) {
     const vec3 p = vec3_make(u(rng), u(rng), u(rng));
-    ASSERT_EQ(grid_density(&view, p), grid_trilinear(g.v.data(), g.nx, g.ny, g.nz, p));
+    ASSERT_EQ(grid_view_density(&view, p), grid_trilinear(g.v.data(), g.nx, g.ny, g.nz, p));
   }
 }
 

@@ -15,6 +15,7 @@
 #include "scene/scene.h"
 #include "shared/light_cache.h"
 #include "volume/grid.h"
+#include "unit/host_context.h"
 
 namespace narval::test {
 namespace {
@@ -223,8 +224,8 @@ TEST(LightCache, EmptyGridGivesTransmittanceOneExactly) {
     uint status = 0;
     ASSERT_TRUE(march_light_as_point(&c.ds.lights[0], p, &dir, &dist, &I));
     const vec3 tr = vec3_exp_neg(
-        light_cache_optical_depth(&c.ds.params.medium, &c.grid, &params, c.slabs.data(), c.ds.lights.data(), 0, p, dir,
-                                  dist, &status));
+        light_cache_optical_depth(narval::test::sceneContext(&c.ds.params, c.ds.lights.data(), &c.grid, &status),
+                                  &params, c.slabs.data(), 0, p, dir, dist));
     ASSERT_EQ(tr.x, 1.0f);
     ASSERT_EQ(tr.y, 1.0f);
     ASSERT_EQ(tr.z, 1.0f);

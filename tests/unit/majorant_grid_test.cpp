@@ -25,6 +25,7 @@
 #include "test_support.h"
 #include "volume/grid.h"
 #include "volume/majorant_grid.h"
+#include "unit/host_context.h"
 
 namespace {
 
@@ -46,7 +47,7 @@ void setVoxel(DenseGrid& g, int x, int y, int z, float v) {
 }
 float density(const DenseGrid& g, float x, float y, float z) {
   const grid_view view{g.data.data(), g.nx, g.ny, g.nz};
-  return grid_density(&view, vec3_make(x, y, z));
+  return grid_view_density(&view, vec3_make(x, y, z));
 }
 
 // A random grid: about `fillFraction` of the voxels nonzero (uniform in (0, 1]), the rest exactly 0.

@@ -9,6 +9,7 @@
 #include "shared/march.h"
 #include "volume/grid.h"
 #include "volume/majorant_grid.h"
+#include "unit/host_context.h"
 
 namespace narval {
 namespace {
@@ -50,12 +51,12 @@ TEST(MarchSkipsEmptySpace, StepsLandOnlyInOccupiedCells) {
   const grid_view skipping{f.grid.data.data(), 32, 8, 8, f.majorants.maxDensity.data()};
   medium_segment seg;
   ASSERT_TRUE(medium_intersect(&m, vec3_make(-20, 0.1f, 0.2f), vec3_make(1, 0, 0), 0.0f, 100.0f, &seg));
-  march_iter it = march_begin(&m, &skipping, &seg, 8);
+  march_iter it = march_begin(narval::test::hostContext(&m, &skipping, nullptr), &seg, 8);
   // The box spans world x in [-16, 16]; the occupied cells are index x in [8, 24] = world [-8, 8].
   EXPECT_NEAR(it.delta * 8, 16.0f, 1e-4f);
   float t;
   int samples = 0;
-  while (march_next(&it, &skipping, &t)) {
+  while (march_next(&it, narval::test::hostContext(nullptr, &skipping, nullptr), &t)) {
     const float x = -20 + t;
     // Sample k sits at the midpoint of step k of the occupied stretch: x = -8 + (k + 0.5)·2.
     EXPECT_NEAR(x, -8 + (samples + 0.5f) * 2, 1e-4f) << "sample " << samples;
@@ -75,15 +76,17 @@ TEST(MarchSkipsEmptySpace, EmptyRaysCostNoSamples) {
   const grid_view& g = skipping;
   medium_segment seg;
   ASSERT_TRUE(medium_intersect(&m, vec3_make(-12, -10, 0), vec3_make(0, 1, 0), 0.0f, 100.0f, &seg));
-  march_iter it = march_begin(&m, &g, &seg, 50);
+  march_iter it = march_begin(narval::test::hostContext(&m, &g, nullptr), &seg, 50);
   float t;
-  EXPECT_FALSE(march_next(&it, &g, &t));
+  EXPECT_FALSE(march_next(&it, narval::test::hostContext(nullptr, &g, nullptr), &t));
   uint status = 0u;
-  EXPECT_EQ(march_optical_depth(&m, &g, vec3_make(-12, -10, 0), vec3_make(0, 1, 0), 100.0f, 50, &status).x, 0.0f);
+  EXPECT_EQ(march_optical_depth(narval::test::hostContext(&m, &g, &status), vec3_make(-12, -10, 0),
+                                vec3_make(0, 1, 0), 100.0f, 50).x,
+            0.0f);
   EXPECT_EQ(status, 0u);
-  march_iter plain = march_begin(&m, &whole, &seg, 50);
+  march_iter plain = march_begin(narval::test::hostContext(&m, &whole, nullptr), &seg, 50);
   int samples = 0;
-  while (march_next(&plain, &whole, &t)) ++samples;
+  while (march_next(&plain, narval::test::hostContext(nullptr, &whole, nullptr), &t)) ++samples;
   EXPECT_EQ(samples, 50);
 }
 

@@ -15,6 +15,7 @@
 #include "shared/majorant.h"
 #include "shared/march.h"
 #include "shared/tracking.h"
+#include "unit/host_context.h"
 
 namespace {
 
@@ -46,14 +47,15 @@ WalkResult delta(const medium_params& m, const grid_view& g, uint seed = 1u) {
   vec3 beta = vec3_splat(1.0f);
   float t = 0.0f;
   WalkResult r;
-  r.event = tracking_delta(&m, &g, vec3_make(0.5f, 0.5f, 0.0f), vec3_make(0, 0, 1), 0.0f, 1.0f, &rng, &beta, &t,
-                           &r.status);
+  r.event = tracking_delta(narval::test::hostContext(&m, &g, &r.status), vec3_make(0.5f, 0.5f, 0.0f),
+                           vec3_make(0, 0, 1), 0.0f, 1.0f, &rng, &beta, &t);
   return r;
 }
 WalkResult ratio(const medium_params& m, const grid_view& g, uint seed = 1u) {
   rng_state rng = rng_init(seed, 2u, 3u);
   WalkResult r;
-  r.tr = tracking_ratio(&m, &g, vec3_make(0.5f, 0.5f, 0.0f), vec3_make(0, 0, 1), 0.0f, 1.0f, &rng, &r.status);
+  r.tr = tracking_ratio(narval::test::hostContext(&m, &g, &r.status), vec3_make(0.5f, 0.5f, 0.0f),
+                        vec3_make(0, 0, 1), 0.0f, 1.0f, &rng);
   return r;
 }
 
@@ -233,12 +235,14 @@ TEST(StatusWordHost, NonFiniteRayIsNanInTheDdaAndTheMarch) {
   const float one[1] = {1.0f};
   const grid_view g = {nullptr, 1, 1, 1, one};
   uint status = 0u;
-  const vec3 tau = march_optical_depth(&m, &g, vec3_make(-1, 0.5f, 0.5f), d, 3.0f, 10, &status);
+  const vec3 tau = march_optical_depth(narval::test::hostContext(&m, &g, &status), vec3_make(-1, 0.5f, 0.5f), d,
+                                       3.0f, 10);
   EXPECT_NEAR(tau.x, 1.0f, 1e-6f);  // σt = 1 across the unit box
   EXPECT_EQ(status, 0u);
-  EXPECT_EQ(march_optical_depth(&m, &g, vec3_make(-1, 5, 0.5f), d, 3.0f, 10, &status).x, 0.0f);  // misses
+  EXPECT_EQ(march_optical_depth(narval::test::hostContext(&m, &g, &status), vec3_make(-1, 5, 0.5f), d, 3.0f, 10).x,
+            0.0f);  // misses
   EXPECT_EQ(status, 0u);
-  EXPECT_EQ(march_optical_depth(&m, &g, nan3, d, 3.0f, 10, &status).x, 0.0f);
+  EXPECT_EQ(march_optical_depth(narval::test::hostContext(&m, &g, &status), nan3, d, 3.0f, 10).x, 0.0f);
   EXPECT_EQ(status, STATUS_NAN);
 }
 

@@ -23,6 +23,7 @@
 #include "unit/stat_util.h"
 #include "volume/grid.h"
 #include "volume/majorant_grid.h"
+#include "unit/host_context.h"
 
 namespace {
 
@@ -208,7 +209,7 @@ double densityIntegral(const narval::DenseGrid& g, const TestRay& r) {
   for (int i = 0; i <= n; ++i) {
     const double t = r.t0 + i * h;
     const vec3 p = vec3_make(float(r.o.x + t * r.d.x), float(r.o.y + t * r.d.y), float(r.o.z + t * r.d.z));
-    sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * grid_density(&v, p);
+    sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * grid_view_density(&v, p);
   }
   return sum * h / 3.0;
 }
@@ -239,7 +240,8 @@ TEST(TrackingMajorantStats, DeltaTrackingEscapesWithTheTransmittance) {
         rng_state rng = rng_init(17u, uint(i), uint(mode));
         vec3 beta = vec3_splat(1.0f);
         float t = 0.0f;
-        const int e = tracking_delta(&g.medium, view, r.o, r.d, r.t0, r.t1, &rng, &beta, &t, &status, &c);
+        const int e = tracking_delta(narval::test::hostContext(&g.medium, view, &status, &c), r.o, r.d, r.t0, r.t1,
+                                     &rng, &beta, &t);
         escaped += e == TRACK_ESCAPED;
         scattered += e == TRACK_SCATTERED;
       }
@@ -279,7 +281,8 @@ TEST(TrackingMajorantStats, SpectralTrackingIsUnbiasedPerChannelOnTheGrid) {
       rng_state rng = rng_init(23u, uint(i), 0u);
       vec3 beta = vec3_splat(1.0f);
       float t = 0.0f;
-      const int e = tracking_delta(&g.medium, &g.withCells, r.o, r.d, r.t0, r.t1, &rng, &beta, &t, &status, &c);
+      const int e = tracking_delta(narval::test::hostContext(&g.medium, &g.withCells, &status, &c), r.o, r.d, r.t0,
+                                   r.t1, &rng, &beta, &t);
       for (int ch = 0; ch < 3; ++ch) {
         esc[ch].add(e == TRACK_ESCAPED ? channelOf(beta, ch) : 0.0);
         sca[ch].add(e == TRACK_SCATTERED ? channelOf(beta, ch) : 0.0);
@@ -311,7 +314,8 @@ TEST(TrackingMajorantStats, RatioTrackingMatchesQuadrature) {
       track_counters c = {0, 0, 0};
       for (int i = 0; i < n; ++i) {
         rng_state rng = rng_init(29u, uint(i), uint(mode));
-        const vec3 tr = tracking_ratio(&g.medium, view, r.o, r.d, r.t0, r.t1, &rng, &status, &c);
+        const vec3 tr = tracking_ratio(narval::test::hostContext(&g.medium, view, &status, &c), r.o, r.d, r.t0, r.t1,
+                                       &rng);
         for (int ch = 0; ch < 3; ++ch) acc[ch].add(channelOf(tr, ch));
       }
       EXPECT_EQ(status, 0u);
@@ -385,16 +389,20 @@ TEST(TrackingMajorantEmptyCells, AWalkThroughEmptyCellsMakesNoLookup) {
     rng_state rng = rng_init(37u, uint(i), 0u);
     vec3 beta = vec3_splat(1.0f);
     float t = 0.0f;
-    EXPECT_EQ(tracking_delta(&g.medium, &g.withCells, seg.o, seg.d, seg.t0, seg.t1, &rng, &beta, &t, &status, &grid),
+    EXPECT_EQ(tracking_delta(narval::test::hostContext(&g.medium, &g.withCells, &status, &grid), seg.o, seg.d,
+                             seg.t0, seg.t1, &rng, &beta, &t),
               TRACK_ESCAPED);
     EXPECT_EQ(rng.used, 1u);  // one draw of the first Philox block
-    const vec3 tr = tracking_ratio(&g.medium, &g.withCells, seg.o, seg.d, seg.t0, seg.t1, &rng, &status, &grid);
+    const vec3 tr = tracking_ratio(narval::test::hostContext(&g.medium, &g.withCells, &status, &grid), seg.o, seg.d,
+                                   seg.t0, seg.t1, &rng);
     EXPECT_EQ(tr.x, 1.0f);
     EXPECT_EQ(tr.z, 1.0f);
     EXPECT_EQ(rng.used, 2u);
     rng_state rng2 = rng_init(37u, uint(i), 1u);
-    tracking_delta(&g.medium, &g.withoutCells, seg.o, seg.d, seg.t0, seg.t1, &rng2, &beta, &t, &status, &global);
-    tracking_ratio(&g.medium, &g.withoutCells, seg.o, seg.d, seg.t0, seg.t1, &rng2, &status, &global);
+    tracking_delta(narval::test::hostContext(&g.medium, &g.withoutCells, &status, &global), seg.o, seg.d, seg.t0,
+                   seg.t1, &rng2, &beta, &t);
+    tracking_ratio(narval::test::hostContext(&g.medium, &g.withoutCells, &status, &global), seg.o, seg.d, seg.t0,
+                   seg.t1, &rng2);
   }
   EXPECT_EQ(status, 0u);
   EXPECT_EQ(grid.tentative, 0u);

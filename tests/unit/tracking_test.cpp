@@ -16,6 +16,7 @@
 #include "shared/medium.h"
 #include "shared/tracking.h"
 #include "unit/stat_util.h"
+#include "unit/host_context.h"
 
 namespace {
 
@@ -130,14 +131,14 @@ TEST(IntersectBox, RayInAFacePlaneIsConsistentAndNaNFree) {
 TEST(GridDensityHost, TrilinearByHand) {
   const float data[8] = {1, 2, 3, 5, 7, 11, 13, 17};
   const grid_view g = {data, 2, 2, 2};
-  EXPECT_EQ(grid_density(&g, vec3_make(0.75f, 1.0f, 1.25f)), 8.84375f);
+  EXPECT_EQ(grid_view_density(&g, vec3_make(0.75f, 1.0f, 1.25f)), 8.84375f);
   // Voxel centres return the voxel exactly.
   for (int z = 0; z < 2; ++z)
     for (int y = 0; y < 2; ++y)
       for (int x = 0; x < 2; ++x)
-        EXPECT_EQ(grid_density(&g, vec3_make(x + 0.5f, y + 0.5f, z + 0.5f)), data[x + 2 * y + 4 * z]);
+        EXPECT_EQ(grid_view_density(&g, vec3_make(x + 0.5f, y + 0.5f, z + 0.5f)), data[x + 2 * y + 4 * z]);
   // Midway between the centres of voxels (0,0,0) and (1,0,0): (1 + 2)/2.
-  EXPECT_EQ(grid_density(&g, vec3_make(1.0f, 0.5f, 0.5f)), 1.5f);
+  EXPECT_EQ(grid_view_density(&g, vec3_make(1.0f, 0.5f, 0.5f)), 1.5f);
 }
 
 // Trilinear interpolation reproduces a linear field exactly between voxel centres: with
@@ -156,7 +157,7 @@ TEST(GridDensityHost, ReproducesALinearField) {
   for (int n = 0; n < 2000; ++n) {
     const vec3 p = vec3_make(ux(gen), uy(gen), uz(gen));
     const double expected = 1.0 + (p.x - 0.5) + 10.0 * (p.y - 0.5) + 100.0 * (p.z - 0.5);
-    ASSERT_NEAR(grid_density(&g, p), expected, 1e-3) << p.x << ", " << p.y << ", " << p.z;
+    ASSERT_NEAR(grid_view_density(&g, p), expected, 1e-3) << p.x << ", " << p.y << ", " << p.z;
   }
 }
 
@@ -170,12 +171,12 @@ TEST(GridDensityHost, ZeroOutsideAndHalfAtTheFace) {
   for (const vec3& p : {vec3_make(-0.5f, 1.0f, 1.0f), vec3_make(2.5f, 1.0f, 1.0f), vec3_make(1.0f, -0.5f, 1.0f),
                         vec3_make(1.0f, 2.5f, 1.0f), vec3_make(1.0f, 1.0f, -0.5f), vec3_make(1.0f, 1.0f, 2.5f),
                         vec3_make(-3.0f, 7.0f, 0.5f), vec3_make(100.0f, -50.0f, 1000.0f)})
-    EXPECT_EQ(grid_density(&g, p), 0.0f) << p.x << ", " << p.y << ", " << p.z;
-  EXPECT_EQ(grid_density(&g, vec3_make(0.0f, 0.5f, 0.5f)), 0.5f);  // (0 + 1)/2
-  EXPECT_EQ(grid_density(&g, vec3_make(2.0f, 0.5f, 0.5f)), 1.0f);  // (2 + 0)/2
+    EXPECT_EQ(grid_view_density(&g, p), 0.0f) << p.x << ", " << p.y << ", " << p.z;
+  EXPECT_EQ(grid_view_density(&g, vec3_make(0.0f, 0.5f, 0.5f)), 0.5f);  // (0 + 1)/2
+  EXPECT_EQ(grid_view_density(&g, vec3_make(2.0f, 0.5f, 0.5f)), 1.0f);  // (2 + 0)/2
   // A homogeneous view (data NULL) is density 1 everywhere.
   const grid_view h = {nullptr, 1, 1, 1};
-  EXPECT_EQ(grid_density(&h, vec3_make(123.0f, -4.0f, 0.5f)), 1.0f);
+  EXPECT_EQ(grid_view_density(&h, vec3_make(123.0f, -4.0f, 0.5f)), 1.0f);
 }
 
 // Far-away and non-finite coordinates must read 0, as on the device, where grid.h clamps the
@@ -188,7 +189,7 @@ TEST(GridDensityHost, HugeAndInfiniteCoordinatesReadZeroLikeTheDevice) {
   const float inf = std::numeric_limits<float>::infinity();
   for (const vec3& p : {vec3_make(1e10f, 0.5f, 0.5f), vec3_make(-1e10f, 0.5f, 0.5f), vec3_make(inf, 0.5f, 0.5f),
                         vec3_make(0.5f, -inf, 0.5f), vec3_make(0.5f, 0.5f, inf)})
-    EXPECT_EQ(grid_density(&g, p), 0.0f) << p.x << ", " << p.y << ", " << p.z;
+    EXPECT_EQ(grid_view_density(&g, p), 0.0f) << p.x << ", " << p.y << ", " << p.z;
 }
 
 // ---- tracking_ratio ----
@@ -201,7 +202,8 @@ TEST(TrackingRatio, HomogeneousIsBeerLambert) {
   rng_state rng = rng_init(1u, 2u, 3u);
   uint status = 0u;
   const float t0 = 0.25f, t1 = 2.0f;
-  const vec3 tr = tracking_ratio(&m, &h, vec3_splat(0.0f), vec3_make(0.0f, 0.0f, 1.0f), t0, t1, &rng, &status);
+  const vec3 tr = tracking_ratio(narval::test::hostContext(&m, &h, &status), vec3_splat(0.0f),
+                                 vec3_make(0.0f, 0.0f, 1.0f), t0, t1, &rng);
   for (int c = 0; c < 3; ++c) {
     const float st = channel4(m.sigma_a, c) + channel4(m.sigma_s, c);
     EXPECT_EQ(channel(tr, c), expf(-(st * (t1 - t0)))) << "channel " << c;
@@ -210,7 +212,8 @@ TEST(TrackingRatio, HomogeneousIsBeerLambert) {
   EXPECT_EQ(rng.used, 4u);  // untouched: no Philox block drawn
   EXPECT_EQ(status, 0u);
   // An empty or reversed interval transmits everything.
-  const vec3 one = tracking_ratio(&m, &h, vec3_splat(0.0f), vec3_make(0.0f, 0.0f, 1.0f), 2.0f, 1.0f, &rng, &status);
+  const vec3 one = tracking_ratio(narval::test::hostContext(&m, &h, &status), vec3_splat(0.0f),
+                                  vec3_make(0.0f, 0.0f, 1.0f), 2.0f, 1.0f, &rng);
   EXPECT_EQ(one.x, 1.0f);
   EXPECT_EQ(one.z, 1.0f);
 }
@@ -251,7 +254,7 @@ double opticalDepthOfDensity(const RandomGridCase& c, float shift) {
     const vec3 p = vec3_make(static_cast<float>(c.o.x + t * c.d.x) + shift, static_cast<float>(c.o.y + t * c.d.y) + shift,
                              static_cast<float>(c.o.z + t * c.d.z) + shift);
     const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
-    sum += w * grid_density(&c.grid, p);
+    sum += w * grid_view_density(&c.grid, p);
   }
   return sum * h / 3.0;
 }
@@ -269,7 +272,7 @@ TEST(TrackingRatio, UnbiasedOnARandomGrid) {
   uint status = 0u;
   for (int i = 0; i < n; ++i) {
     rng_state rng = rng_init(9u, static_cast<uint>(i), 0u);
-    const vec3 tr = tracking_ratio(&c.medium, &c.grid, c.o, c.d, c.t0, c.t1, &rng, &status);
+    const vec3 tr = tracking_ratio(narval::test::hostContext(&c.medium, &c.grid, &status), c.o, c.d, c.t0, c.t1, &rng);
     for (int ch = 0; ch < 3; ++ch) acc[ch].add(channel(tr, ch));
   }
   EXPECT_EQ(status, 0u);
@@ -302,7 +305,8 @@ TEST(TrackingDelta, GreyHomogeneousEventProbabilities) {
     rng_state rng = rng_init(3u, static_cast<uint>(i), 7u);
     vec3 beta = vec3_splat(1.0f);
     float t = -1.0f;
-    const int e = tracking_delta(&m, &h, vec3_splat(0.0f), vec3_make(1, 0, 0), t0, t0 + L, &rng, &beta, &t, &status);
+    const int e = tracking_delta(narval::test::hostContext(&m, &h, &status), vec3_splat(0.0f), vec3_make(1, 0, 0),
+                                 t0, t0 + L, &rng, &beta, &t);
     ASSERT_GE(e, 0);
     ASSERT_LE(e, 2);
     ++counts[e];
@@ -338,7 +342,8 @@ TEST(TrackingDelta, BinomialBoundSeesAOnePercentError) {
     rng_state rng = rng_init(3u, static_cast<uint>(i), 7u);
     vec3 beta = vec3_splat(1.0f);
     float t = 0.0f;
-    escaped += tracking_delta(&m, &h, vec3_splat(0.0f), vec3_make(1, 0, 0), 0.25f, 1.75f, &rng, &beta, &t, &status) ==
+    escaped += tracking_delta(narval::test::hostContext(&m, &h, &status), vec3_splat(0.0f), vec3_make(1, 0, 0),
+                              0.25f, 1.75f, &rng, &beta, &t) ==
                TRACK_ESCAPED;
   }
   const double T = std::exp(-1.5), sigma = std::sqrt(T * (1.0 - T) / n);
@@ -362,7 +367,8 @@ TEST(TrackingDelta, ChromaticSpectralTrackingIsUnbiasedPerChannel) {
     rng_state rng = rng_init(4u, static_cast<uint>(i), 0u);
     vec3 beta = vec3_splat(1.0f);
     float t = 0.0f;
-    const int e = tracking_delta(&m, &h, vec3_splat(0.0f), vec3_make(0, 1, 0), 0.0f, L, &rng, &beta, &t, &status);
+    const int e = tracking_delta(narval::test::hostContext(&m, &h, &status), vec3_splat(0.0f), vec3_make(0, 1, 0),
+                                 0.0f, L, &rng, &beta, &t);
     ASSERT_TRUE(vec3_is_finite(beta));
     for (int c = 0; c < 3; ++c) {
       esc[c].add(e == TRACK_ESCAPED ? channel(beta, c) : 0.0);
@@ -391,15 +397,18 @@ TEST(TrackingDelta, ZeroMajorantEscapesAndIterationCapIsFlagged) {
   float t = 0.0f;
   uint status = 0u;
   const medium_params empty = makeMedium(grey4(0.5f), grey4(0.5f), 0.0f, 1, {1, 1, 1, 0});
-  EXPECT_EQ(tracking_delta(&empty, &h, vec3_splat(0.0f), vec3_make(1, 0, 0), 0.0f, 1.0f, &rng, &beta, &t, &status),
+  EXPECT_EQ(tracking_delta(narval::test::hostContext(&empty, &h, &status), vec3_splat(0.0f), vec3_make(1, 0, 0),
+                           0.0f, 1.0f, &rng, &beta, &t),
             TRACK_ESCAPED);
   EXPECT_EQ(status, 0u);
   const medium_params nullOnly = makeMedium(grey4(0.0f), grey4(0.0f), 1e9f, 1, {1, 1, 1, 0});
-  EXPECT_EQ(tracking_delta(&nullOnly, &h, vec3_splat(0.0f), vec3_make(1, 0, 0), 0.25f, 1.0f, &rng, &beta, &t, &status),
+  EXPECT_EQ(tracking_delta(narval::test::hostContext(&nullOnly, &h, &status), vec3_splat(0.0f), vec3_make(1, 0, 0),
+                           0.25f, 1.0f, &rng, &beta, &t),
             TRACK_ABSORBED);
   EXPECT_EQ(status, static_cast<uint>(STATUS_ITERATION_CAP));
   status = 0u;
-  const vec3 tr = tracking_ratio(&nullOnly, &g, vec3_make(0.5f, 0.5f, 0.0f), vec3_make(0, 0, 1), 0.25f, 0.75f, &rng, &status);
+  const vec3 tr = tracking_ratio(narval::test::hostContext(&nullOnly, &g, &status), vec3_make(0.5f, 0.5f, 0.0f),
+                                 vec3_make(0, 0, 1), 0.25f, 0.75f, &rng);
   EXPECT_EQ(tr.x, 0.0f);
   EXPECT_EQ(status, static_cast<uint>(STATUS_ITERATION_CAP));
 }
