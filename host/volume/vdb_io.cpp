@@ -475,22 +475,35 @@ bool decodeInChild(const std::string& path, const std::string& gridName, DenseGr
   return true;
 }
 
-bool namesInChild(const std::string& path, std::vector<std::string>& names) {
+// Runs produce() in a child (runInChild) and passes the text it returns back into *text; false
+// when no child can be used. `cannot` words the failures ("cannot list the grids").
+template <typename Produce>
+bool textInChild(const std::string& path, const std::string& cannot, Produce&& produce, std::string* text) {
   Fd mem;
   ChildRecord rec{};
   auto work = [&](int fd, ChildRecord& result) {
-    std::string joined;
-    for (const std::string& n : floatGridNames(path)) joined.append(n).push_back('\0');
-    result.payloadBytes = uint32_t(joined.size());
-    if (::pwrite(fd, joined.data(), joined.size(), off_t(kDataOffset)) != ssize_t(joined.size())) {
-      throw std::runtime_error("cannot pass the grid names back");
+    const std::string out = produce();
+    result.payloadBytes = uint32_t(out.size());
+    if (::pwrite(fd, out.data(), out.size(), off_t(kDataOffset)) != ssize_t(out.size())) {
+      throw std::runtime_error(cannot + ": cannot pass the result back");
     }
   };
-  if (!runInChild(path, "cannot list the grids", work, mem, rec)) return false;
-  std::string joined(rec.payloadBytes, '\0');
-  if (::pread(mem.fd, joined.data(), joined.size(), off_t(kDataOffset)) != ssize_t(joined.size())) {
-    throw inputError(path, "grid", "cannot list the grids (the reader process returned an inconsistent result)");
+  if (!runInChild(path, cannot, work, mem, rec)) return false;
+  text->assign(rec.payloadBytes, '\0');
+  if (::pread(mem.fd, text->data(), text->size(), off_t(kDataOffset)) != ssize_t(text->size())) {
+    throw inputError(path, "grid", cannot + " (the reader process returned an inconsistent result)");
   }
+  return true;
+}
+
+bool namesInChild(const std::string& path, std::vector<std::string>& names) {
+  std::string joined;
+  const bool ran = textInChild(path, "cannot list the grids", [&] {
+    std::string out;
+    for (const std::string& n : floatGridNames(path)) out.append(n).push_back('\0');
+    return out;
+  }, &joined);
+  if (!ran) return false;
   for (size_t start = 0; start < joined.size();) {
     const size_t end = joined.find('\0', start);
     names.push_back(joined.substr(start, end - start));
@@ -500,20 +513,10 @@ bool namesInChild(const std::string& path, std::vector<std::string>& names) {
 }
 
 bool describeInChild(const std::string& path, std::vector<GridInfo>& infos) {
-  Fd mem;
-  ChildRecord rec{};
-  auto work = [&](int fd, ChildRecord& result) {
-    const std::string text = gridInfoJson(path, describeVdbGrids(path));
-    result.payloadBytes = uint32_t(text.size());
-    if (::pwrite(fd, text.data(), text.size(), off_t(kDataOffset)) != ssize_t(text.size())) {
-      throw std::runtime_error("cannot pass the grids' description back");
-    }
-  };
-  if (!runInChild(path, "cannot describe the grids", work, mem, rec)) return false;
-  std::string text(rec.payloadBytes, '\0');
-  if (::pread(mem.fd, text.data(), text.size(), off_t(kDataOffset)) != ssize_t(text.size())) {
-    throw inputError(path, "grid", "cannot describe the grids (the reader process returned an inconsistent result)");
-  }
+  std::string text;
+  if (!textInChild(path, "cannot describe the grids", [&] { return gridInfoJson(path, describeVdbGrids(path)); },
+                   &text))
+    return false;
   infos = gridInfoFromJson(text);
   return true;
 }
