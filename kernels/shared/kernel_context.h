@@ -31,7 +31,7 @@ typedef struct kernel_context {
   NV_CONSTANT const medium_params* medium; /* &scene->medium (host tests may point it at a medium alone) */
 #ifdef NV_DEVICE
 #if GRID_STORAGE_IN_CONTEXT
-  GRID_STORAGE grid;          /* the density grid (buffer or bricks storage) */
+  GRID_STORAGE grid;          /* the density grid (buffer or bricks; homogeneous: an unused int) */
   GRID_STORAGE emission_grid; /* the emission grid, or the density grid again (emission.h) */
 #endif
   NV_GLOBAL const float* majorants;      /* the majorant grid's per-cell density bounds */
