@@ -4,6 +4,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "scene/input_error.h"
+
 namespace narval {
 namespace {
 
@@ -14,9 +16,11 @@ std::string joinBuildOptions(const std::string& base, const std::string& extra) 
   return base + " " + extra;
 }
 
-// A kind the kernels do not know (structs.h): the host's own error, never the user's input.
-std::logic_error unknownKind(const std::string& what, int kind) {
-  return std::logic_error("the kernels know no " + what + " kind " + std::to_string(kind));
+// A kind the kernels do not know (structs.h): a scene this build cannot render, refused as bad
+// input (one line, exit 2) before anything is built. The loader produces only known kinds, so it
+// means a host and kernels out of step.
+InputError unknownKind(const std::string& what, int kind) {
+  return InputError("the kernels know no " + what + " kind " + std::to_string(kind));
 }
 
 }  // namespace

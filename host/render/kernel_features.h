@@ -60,7 +60,8 @@ std::string sceneBuildOptions(const DeviceScene& ds);
 std::string gridStorageBuildOption(GridStorage storage);
 
 // The feature options of `ds`, space-separated in the order of the table above ("" for none).
-// Throws std::logic_error for a phase function, light or emission kind the kernels do not know.
+// Throws InputError ("the kernels know no light kind 5") for a phase function, light or emission
+// kind the kernels do not know.
 std::string sceneFeatureOptions(const DeviceScene& ds);
 
 // False when NARVAL_GENERIC is set to anything but "" or "0".

@@ -293,7 +293,11 @@ DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids) {
   if (ds.emissionTable.empty()) ds.emissionTable.assign(3, 0.0f);
   sp.num_lights = int(ds.lights.size());
   if (ds.lights.empty()) ds.lights.push_back(light_params{});  // a buffer may not be empty
-  ds.buildOptions = sceneBuildOptions(ds);  // render/kernel_features.h
+  try {
+    ds.buildOptions = sceneBuildOptions(ds);  // render/kernel_features.h
+  } catch (const InputError& e) {
+    throw inputError(scene.sourcePath, "", e.what());  // an unknown kind: named with the scene's file
+  }
   return ds;
 }
 

@@ -13,6 +13,7 @@
 
 #include "render/kernel_features.h"
 #include "render_fixture.h"
+#include "scene/input_error.h"
 #include "volume/grid.h"
 
 namespace narval::test {
@@ -137,15 +138,16 @@ void expectSpecialisedEqualsGeneric(const SceneSpec& spec, const DenseGrid* grid
   }
 }
 
-// A kind the kernels do not know is the host's error before any build, with or without
-// specialisation (a host and kernels out of step; the loader never produces one).
+// A kind the kernels do not know is refused on the host before any build, with or without
+// specialisation, as bad input (InputError: one line, exit 2 in the CLI; buildDeviceScene prefixes
+// the scene's file). The loader never produces one: it means a host and kernels out of step.
 TEST(KernelFeatures, UnknownKindsAreAnErrorOnTheHost) {
   DeviceScene ds = buildDeviceScene(sceneFromJson(sceneJson({"hg", true, true, true, false})), nullptr);
   ds.params.medium.phase = 7;
   try {
     sceneBuildOptions(ds);
     FAIL() << "no error";
-  } catch (const std::logic_error& e) {
+  } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "the kernels know no phase function kind 7");
   }
   ds.params.medium.phase = PHASE_HG;
@@ -154,7 +156,7 @@ TEST(KernelFeatures, UnknownKindsAreAnErrorOnTheHost) {
   try {
     sceneBuildOptions(ds);
     FAIL() << "no error";
-  } catch (const std::logic_error& e) {
+  } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "the kernels know no light kind 5");
   }
   ds.lights[0].type = LIGHT_RECTANGLE;
@@ -162,7 +164,7 @@ TEST(KernelFeatures, UnknownKindsAreAnErrorOnTheHost) {
   try {
     sceneBuildOptions(ds);
     FAIL() << "no error";
-  } catch (const std::logic_error& e) {
+  } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "the kernels know no emission kind 9");
   }
 }
