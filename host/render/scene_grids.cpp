@@ -1,8 +1,5 @@
 #include "render/scene_grids.h"
 
-#include <cctype>
-#include <filesystem>
-
 #include "scene/input_error.h"
 
 namespace narval {
@@ -18,8 +15,7 @@ SceneGrids loadSceneGrids(const Scene& scene, SceneGridStorage& storage) {
     if (e.grid == m.gridName) return {&storage.density, &storage.density};
     const std::string key = "materials[" + std::to_string(p.materialIndex) + "].emission." +
                             (e.kind == EmissionKind::Blackbody ? "temperature" : "grid");
-    std::string ext = std::filesystem::path(m.path).extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = gridFileExtension(m.path);
     if (ext != ".vdb")
       throw inputError(scene.sourcePath, key, "names a grid, but " + m.path + " is not an OpenVDB file (a " +
                                                   ext + " file holds one unnamed grid)");

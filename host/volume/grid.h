@@ -35,6 +35,9 @@ constexpr uint64_t kMaxDenseGridBytes = uint64_t(8) << 30;
 // Loads `path` by extension (.vdb: FloatGrid `gridName`; .vol: text). Throws InputError naming the
 // file on anything wrong (missing file, missing grid with the list of grids present, bad data).
 DenseGrid loadGrid(const std::string& path, const std::string& gridName = "density");
+// The extension of `path` in lower case (".vdb", ".vol", "" without one): how loadGrid and the
+// other readers of grid files tell the formats apart.
+std::string gridFileExtension(const std::string& path);
 DenseGrid loadVdb(const std::string& path, const std::string& gridName);
 DenseGrid loadVol(const std::string& path);
 // The .vol text from a seekable stream positioned at its start (loadVol is this on the opened

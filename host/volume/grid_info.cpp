@@ -1,7 +1,6 @@
 #include "volume/grid_info.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -42,16 +41,10 @@ std::string bytes(uint64_t n) {
   return b;
 }
 
-std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 }  // namespace
 
 std::vector<GridInfo> inspectGridFile(const std::string& path) {
-  const std::string ext = lowerExtension(path);
+  const std::string ext = gridFileExtension(path);
   if (ext == ".vdb") return inspectVdb(path);
   if (ext != ".vol")
     throw inputError(path, "", "unknown volume file type '" +

@@ -156,11 +156,6 @@ bool parseDim(std::string_view tok, uint64_t& v) {
   return v > 0;
 }
 
-std::string lower(std::string s) {
-  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 }  // namespace
 
 void checkDensityValues(DenseGrid& grid, const std::string& key, const std::string& subject) {
@@ -303,8 +298,14 @@ DenseGrid parseVol(std::istream& in, const std::string& path, size_t chunkBytes)
   return grid;
 }
 
+std::string gridFileExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
 DenseGrid loadGrid(const std::string& path, const std::string& gridName) {
-  const std::string ext = lower(fs::path(path).extension().string());
+  const std::string ext = gridFileExtension(path);
   if (ext == ".vdb") return loadVdb(path, gridName.empty() ? std::string("density") : gridName);
   if (ext == ".vol") return loadVol(path);
   throw inputError(path, "",
