@@ -83,9 +83,12 @@ while IFS=$'\t' read -r -u 3 index type name; do
   [ -n "$first" ] || first=$index
   out="$work/dev_$index.exr"
   common=(--device "$index" --algorithm "$algorithm" --resolution "$resolution")
+  # --spp applies to the path tracer only (narval refuses it for the real-time algorithms).
+  warm_spp=() spp_flag=()
+  if [ "$algorithm" = pathtrace ]; then warm_spp=(--spp 1) spp_flag=(--spp "$spp"); fi
   build/narval render "$scene" -o "$work/warm.exr" --device "$index" --algorithm "$algorithm" \
-    --spp 1 --resolution 16x8 >/dev/null
-  build/narval render "$scene" -o "$out" "${common[@]}" --spp "$spp" \
+    "${warm_spp[@]}" --resolution 16x8 >/dev/null
+  build/narval render "$scene" -o "$out" "${common[@]}" "${spp_flag[@]}" \
     --stats-json "$work/dev_$index.json" >/dev/null
   build/narval render "$scene" -o "$work/frames_$index.exr" "${common[@]}" --frames "$frames" \
     --stats-json "$work/frames_$index.json" >/dev/null
@@ -104,7 +107,7 @@ PY
   )")
 done 3<"$work/devices.tsv"
 
-# raymarch and lobe render one pass whatever --spp says: report what narval rendered.
+# raymarch and lobe render one pass: report what narval rendered.
 rendered_spp=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['spp'])" "$work/dev_$first.json")
 echo "$(date -u '+%Y-%m-%d %H:%M UTC') — scene $scene, $algorithm, $rendered_spp spp, $resolution;" \
   "ms/frame: median kernel time of --frames $frames (narval sets the first frame apart);" \

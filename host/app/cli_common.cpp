@@ -1,6 +1,7 @@
 #include "app/cli_common.h"
 
 #include <cstdio>
+#include <cstdlib>
 #include <regex>
 
 #include "image/atomic_file.h"
@@ -19,6 +20,82 @@ std::pair<int, int> parseSize(const std::string& text, const std::string& what) 
 std::string resolutionOverride(const std::string& text) {
   const auto [w, h] = parseSize(text, "--resolution");
   return "renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]";
+}
+
+namespace {
+// Reads the integer in `text`; false when it is not one (CLI11 validates the text before converting).
+bool parseInteger(const std::string& text, long long* out) {
+  static const std::regex re(R"(^[+-]?\d{1,18}$)");
+  if (!std::regex_match(text, re)) return false;
+  *out = std::stoll(text);
+  return true;
+}
+}  // namespace
+
+CLI::Validator atLeast(long long min) {
+  return CLI::Validator(
+      [min](std::string& text) -> std::string {
+        long long v = 0;
+        if (!parseInteger(text, &v)) return "expected an integer, got '" + text + "'";
+        return v < min ? "must be at least " + std::to_string(min) + ", got " + text : std::string();
+      },
+      "INT >= " + std::to_string(min));
+}
+
+CLI::Validator between(long long min, long long max) {
+  return CLI::Validator(
+      [min, max](std::string& text) -> std::string {
+        long long v = 0;
+        if (!parseInteger(text, &v)) return "expected an integer, got '" + text + "'";
+        return v < min || v > max
+                   ? "must be between " + std::to_string(min) + " and " + std::to_string(max) + ", got " + text
+                   : std::string();
+      },
+      "INT in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+}
+
+CLI::Validator greaterThanZero() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0') return "expected a number, got '" + text + "'";
+        return v > 0 && v < 1e9 ? std::string() : "must be greater than 0, got " + text;
+      },
+      "NUMBER > 0");
+}
+
+void addThreadsOption(CLI::App* sub) {
+  sub->add_option_function<int>(
+         "--threads",
+         [](const int& n) {
+           // PoCL reads its thread count once, when the platform is first created (narval opens no
+           // device before the command runs). POCL_CPU_MAX_CU_NUM is the name newer PoCL reads.
+           const std::string v = std::to_string(n);
+           setenv("POCL_MAX_PTHREAD_COUNT", v.c_str(), 1);
+           setenv("POCL_CPU_MAX_CU_NUM", v.c_str(), 1);
+         },
+         "Worker threads of a PoCL CPU device (sets POCL_MAX_PTHREAD_COUNT; default: one per core; other "
+         "OpenCL drivers ignore it)")
+      ->check(between(1, 4096));
+}
+
+void addQuietOption(CLI::App* sub, bool* quiet) {
+  sub->add_flag("-q,--quiet", *quiet, "Print only errors and warnings (no progress bar, no report lines)");
+}
+
+void checkLocalSize(int lx, int ly, const cl::Device& device, const std::string& deviceName) {
+  const size_t items = size_t(lx) * size_t(ly);
+  const size_t most = device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>();
+  const std::vector<size_t> sides = device.getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
+  const std::string shape = std::to_string(lx) + "x" + std::to_string(ly);
+  if (items > most)
+    throw inputError("--local-size", "", shape + " is " + std::to_string(items) + " work-items; " + deviceName +
+                                             " takes at most " + std::to_string(most) + " per group");
+  for (size_t i = 0; i < 2 && i < sides.size(); ++i)
+    if (size_t(i == 0 ? lx : ly) > sides[i])
+      throw inputError("--local-size", "", shape + ": " + deviceName + " takes at most " + std::to_string(sides[i]) +
+                                               " work-items along " + (i == 0 ? "x" : "y"));
 }
 
 }  // namespace narval

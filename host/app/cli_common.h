@@ -5,6 +5,9 @@
 #include <string>
 #include <utility>
 
+#include <CLI/CLI.hpp>
+
+#include "cl/cl_runtime.h"
 #include "image/atomic_file.h"  // writeTextAtomic
 #include "render/scene_grids.h"  // loadSceneGrids
 #include "scene/scene.h"
@@ -17,6 +20,24 @@ std::pair<int, int> parseSize(const std::string& text, const std::string& what);
 
 // --resolution WxH as the scene override "renderer.resolution=[W,H]" (parseSize's errors name the flag).
 std::string resolutionOverride(const std::string& text);
+
+// Numeric checks whose messages read like the scene loader's ("--spp: must be at least 1, got 0"),
+// not CLI11's range text with a 309-digit bound.
+CLI::Validator atLeast(long long min);
+CLI::Validator between(long long min, long long max);
+CLI::Validator greaterThanZero();  // any number > 0 (and below 1e9)
+
+// --threads N on a subcommand that opens a device: PoCL's worker threads on a CPU device (it sets
+// POCL_MAX_PTHREAD_COUNT before the OpenCL platform is first asked for, so it must be parsed before
+// any device is opened); other OpenCL drivers ignore it.
+void addThreadsOption(CLI::App* sub);
+
+// --quiet: only errors and warnings on stderr; no progress bar and no report lines on stdout.
+void addQuietOption(CLI::App* sub, bool* quiet);
+
+// Fails with "--local-size: WxH is N work-items; DEVICE takes at most M per group" (exit 2)
+// when the shape cannot be launched on the device, instead of CL_INVALID_WORK_GROUP_SIZE later.
+void checkLocalSize(int lx, int ly, const cl::Device& device, const std::string& deviceName);
 
 
 }  // namespace narval

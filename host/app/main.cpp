@@ -24,6 +24,9 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const CLI::ValidationError& e) {  // a value out of range: the message says what is allowed
+    std::cerr << "narval: " << e.what() << "\n";
+    return 2;
   } catch (const CLI::ParseError& e) {
     std::cerr << "narval: " << e.what() << " (see narval --help)\n";
     return 2;

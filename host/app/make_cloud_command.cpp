@@ -2,6 +2,7 @@
 #include <chrono>
 #include <iostream>
 
+#include "app/cli_common.h"
 #include "app/commands.h"
 #include "scene/input_error.h"
 #include "volume/grid.h"
@@ -17,7 +18,7 @@ Command addMakeCloudCommand(CLI::App& app) {
   };
   auto a = std::make_shared<Args>();
   sub->add_option("OUT.vdb", a->out, "Output .vdb file")->required();
-  sub->add_option("--resolution", a->resolution, "Voxels per side")->check(CLI::Range(8, 2048));
+  sub->add_option("--resolution", a->resolution, "Voxels per side")->check(between(8, 2048));
   sub->add_option("--seed", a->seed, "Shape seed");
   return {sub, [a]() {
             const auto t0 = std::chrono::steady_clock::now();

@@ -8,7 +8,8 @@ namespace narval {
 
 class ProgressBar {
  public:
-  explicit ProgressBar(std::string label);
+  // `enabled` false (--quiet) draws nothing even on a terminal.
+  explicit ProgressBar(std::string label, bool enabled = true);
   void update(int done, int total);
   void finish();
 

@@ -29,7 +29,9 @@ namespace {
 struct RenderArgs {
   std::string scene, out, algorithm, resolution, device, statsJson, localSize = "8x8";
   int spp = -1, bounces = -1, frames = 0, samplesPerPass = 0, majorantResolution = 0;
-  bool resume = false, counters = false;
+  bool resume = false, counters = false, quiet = false;
+  std::optional<double> exposure;
+  std::string tonemap;
   std::string majorant = "auto", storage, displayServer;
   double partialEverySeconds = 0;
   long long seed = -1;
@@ -45,6 +47,8 @@ std::vector<std::string> overridesFrom(const RenderArgs& a) {
   if (!a.algorithm.empty()) o.push_back("renderer.algorithm=\"" + a.algorithm + "\"");
   if (!a.storage.empty()) o.push_back("renderer.storage=\"" + a.storage + "\"");
   if (!a.resolution.empty()) o.push_back(resolutionOverride(a.resolution));
+  if (a.exposure) o.push_back("renderer.exposure=" + nlohmann::json(*a.exposure).dump());
+  if (!a.tonemap.empty()) o.push_back("renderer.toneMapping=\"" + a.tonemap + "\"");
   return o;
 }
 
@@ -118,11 +122,22 @@ void resumeMajorant(const std::string& out, const RenderArgs& a, std::string* ma
 }
 
 int runRender(const RenderArgs& a) {
+  std::ostream silent(nullptr);  // --quiet: report lines go nowhere (a stream without a buffer drops them)
+  std::ostream& report = a.quiet ? silent : std::cout;
   Scene scene = loadScene(a.scene, overridesFrom(a));
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
   const bool realtime = isRealtime(scene.renderer.algorithm);
   const std::string algorithm = algorithmName(scene.renderer.algorithm);
   const auto [lx, ly] = parseSize(a.localSize, "--local-size");
+  // The real-time algorithms take one estimate per pixel per frame; only the ray marcher's
+  // multiple-scattering cache traces paths, and it takes the scene's bounces.
+  if (realtime && a.spp >= 0)
+    throw inputError("--spp", "", "does not apply to " + algorithm + ", which renders frames (use --frames)");
+  const bool cachePaths = scene.renderer.algorithm == Algorithm::Raymarch &&
+                          scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache;
+  if (realtime && a.bounces >= 0 && !cachePaths)
+    throw inputError("--bounces", "", "does not apply to " + algorithm +
+                                          " (only the ray marcher's multiple-scattering cache traces bounces)");
   if (a.counters && realtime)
     throw inputError("--counters", "", "only the path tracer counts collisions; the algorithm is " + algorithm);
 
@@ -143,7 +158,7 @@ int runRender(const RenderArgs& a) {
       resuming = true;
       resumeMajorant(out.string(), a, &majorant, &majorantResolution);
       if (resumeState.samples == scene.renderer.spp) {
-        std::cout << out.string() << " already has " << resumeState.samples << " spp; nothing to render\n";
+        report << out.string() << " already has " << resumeState.samples << " spp; nothing to render\n";
         return 0;
       }
     } else {
@@ -162,8 +177,9 @@ int runRender(const RenderArgs& a) {
   const SceneGrids g = loadSceneGrids(scene, gridStorage);
   const InterruptWatch interrupt;  // from here on, Ctrl-C stops after the pass in flight
   ClRuntime rt(a.device);
+  checkLocalSize(lx, ly, rt.selected.device, rt.selected.info.name);
 
-  ProgressBar bar((realtime ? "frames of " : "rendering ") + fs::path(a.scene).filename().string());
+  ProgressBar bar((realtime ? "frames of " : "rendering ") + fs::path(a.scene).filename().string(), !a.quiet);
   RenderOptions options;
   options.localSizeX = lx;
   options.localSizeY = ly;
@@ -242,26 +258,26 @@ int runRender(const RenderArgs& a) {
     return kExitInterrupted;
   }
   if (a.frames > 0)
-    std::cout << s.algorithm << ": " << s.frames.count << " frames, first " << s.frames.firstKernelMs
+    report << s.algorithm << ": " << s.frames.count << " frames, first " << s.frames.firstKernelMs
               << " ms, then median " << s.frames.medianKernelMs << " ms (min " << s.frames.minKernelMs << ", max "
               << s.frames.maxKernelMs << ") per frame by profiling events, median " << s.frames.medianWallMs
               << " ms by wall clock\n";
   if (s.lightCacheBuilds > 0)
-    std::cout << "light cache: " << s.lightCacheCells[0] << "x" << s.lightCacheCells[1] << "x" << s.lightCacheCells[2]
+    report << "light cache: " << s.lightCacheCells[0] << "x" << s.lightCacheCells[1] << "x" << s.lightCacheCells[2]
               << " cells, " << s.lightCacheBuilds << (s.lightCacheBuilds == 1 ? " light" : " lights") << " built in "
               << s.lightCacheMs << " ms (not in the frame times)\n";
   if (s.msCacheBuilds > 0)
-    std::cout << "multiple-scattering cache: " << s.msCacheCells[0] << "x" << s.msCacheCells[1] << "x"
+    report << "multiple-scattering cache: " << s.msCacheCells[0] << "x" << s.msCacheCells[1] << "x"
               << s.msCacheCells[2] << " cells, " << s.msCachePaths << " paths per node in " << s.msCacheMs
               << " ms (not in the frame times)\n";
-  std::cout << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
+  report << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
             << s.algorithm << ", ";
   if (realtime)
-    std::cout << s.frames.count << " frame(s), " << s.frames.medianKernelMs << " ms per frame";
+    report << s.frames.count << " frame(s), " << s.frames.medianKernelMs << " ms per frame";
   else
-    std::cout << s.spp << " spp, " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6
+    report << s.spp << " spp, " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6
               << " Msamples/s";
-  std::cout << " on " << s.device << ")\n";
+  report << " on " << s.device << ")\n";
   return 0;
 }
 
@@ -273,15 +289,17 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("SCENE.json", a->scene, "Scene file")->required();
   sub->add_option("-o,--output", a->out, "Output .exr (the .png goes beside it); default: <scene name>.exr");
   sub->add_option("--algorithm", a->algorithm, "pathtrace | raymarch | lobe");
-  sub->add_option("--spp", a->spp, "Samples per pixel")->check(CLI::PositiveNumber);
-  sub->add_option("--bounces", a->bounces, "Real scattering events per path")->check(CLI::NonNegativeNumber);
+  sub->add_option("--spp", a->spp, "pathtrace: samples per pixel")->check(atLeast(1));
+  sub->add_option("--bounces", a->bounces,
+                  "pathtrace and the ray marcher's multiple-scattering cache: real scattering events per path")
+      ->check(atLeast(0));
   sub->add_option("--resolution", a->resolution, "WIDTHxHEIGHT");
   sub->add_option("--device", a->device, "Device index or name substring (narval devices)");
-  sub->add_option("--seed", a->seed, "Random seed")->check(CLI::Range(0LL, 4294967295LL));
+  sub->add_option("--seed", a->seed, "Random seed")->check(between(0, 4294967295LL));
   sub->add_option("--set", a->sets, "Override a scene value: dotted.path=value (repeatable)");
   sub->add_option("--frames", a->frames,
                   "Render K frames and report ms per frame (pathtrace: K passes of 1 spp)")
-      ->check(CLI::PositiveNumber);
+      ->check(atLeast(1));
   sub->add_option("--stats-json", a->statsJson, "Write render statistics as JSON");
   sub->add_option("--storage", a->storage,
                   "Density grid on the device: image (3D image, hardware sampler), buffer (float buffer, the "
@@ -292,14 +310,14 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("--samples-per-pass", a->samplesPerPass,
                   "pathtrace: samples per pixel per launch (default: about 2^20 paths per launch); never "
                   "changes the pixels")
-      ->check(CLI::PositiveNumber);
+      ->check(atLeast(1));
   sub->add_option("--majorant", a->majorant,
                   "pathtrace: majorant of delta and ratio tracking: grid (per cell of a coarse grid, walked by "
                   "DDA), global (one for the whole medium), or auto (default: grid on CPUs, global on GPUs)")
       ->check(CLI::IsMember({"auto", "grid", "global"}));
   sub->add_option("--majorant-resolution", a->majorantResolution,
                   "Majorant grid cells along the grid's longest axis (0: automatic)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(atLeast(0));
   sub->add_flag("--counters", a->counters,
                 "pathtrace: count tentative and real collisions and density lookups (a kernel built to count; "
                 "--stats-json reports them)");
@@ -309,7 +327,12 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("--write-partial-images", a->partialEverySeconds,
                   "pathtrace: every SECONDS, write the EXR so far over the output (atomically; --resume "
                   "continues it)")
-      ->check(CLI::PositiveNumber);
+      ->check(greaterThanZero());
+  sub->add_option("--exposure", a->exposure, "Exposure in stops of the PNG (overrides renderer.exposure)");
+  sub->add_option("--tonemap", a->tonemap, "Tone mapping of the PNG: none | reinhard | aces (overrides renderer.toneMapping)")
+      ->check(CLI::IsMember({"none", "reinhard", "aces"}));
+  addQuietOption(sub, &a->quiet);
+  addThreadsOption(sub);
   CLI::Option* frames = sub->get_option("--frames");
   sub->add_flag("--resume", a->resume,
                 "pathtrace: continue the render already at the output path (interrupted, or with fewer spp) "

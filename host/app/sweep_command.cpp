@@ -161,7 +161,8 @@ Command addSweepCommand(CLI::App& app) {
   sub->add_option("--algorithm", a->algorithm, "pathtrace (the only one for now)");
   sub->add_option("--resolution", a->resolution, "WIDTHxHEIGHT");
   sub->add_option("--device", a->device, "Device index or name substring (narval devices)");
-  sub->add_option("--seed", a->seed, "Random seed")->check(CLI::Range(0LL, 4294967295LL));
+  sub->add_option("--seed", a->seed, "Random seed")->check(between(0, 4294967295LL));
+  addThreadsOption(sub);
   sub->add_option("--set", a->sets, "Override a scene value: dotted.path=value (repeatable)");
   return {sub, [a]() { return runSweepCommand(*a); }};
 }

@@ -73,6 +73,7 @@ int runView(const ViewArgs& a) {
   SceneGridStorage gridStorage;
   const SceneGrids grid = loadSceneGrids(scene, gridStorage);
   ClRuntime rt(a.device);
+  checkLocalSize(lx, ly, rt.selected.device, rt.selected.info.name);
   ViewerSession session(rt, scene, grid, options);
   window.run(session, run);
 
@@ -127,15 +128,16 @@ Command addViewCommand(CLI::App& app) {
   sub->add_option("--target-ms", a->targetMs,
                   "While the camera moves, render at 1/2, 1/4 or 1/8 resolution so that a frame takes about this "
                   "long (default 50)")
-      ->check(CLI::PositiveNumber);
+      ->check(greaterThanZero());
   sub->add_option("--script", a->script,
                   "Replay the inputs in FILE instead of a user (key, drag, scroll, hold, frames; README)");
   sub->add_option("--frames", a->frames, "Stop after N frames (default with --script: the script's frames)")
-      ->check(CLI::PositiveNumber);
+      ->check(atLeast(1));
   sub->add_option("--screenshot", a->screenshot, "Save the window's last frame as PNG");
   sub->add_option("--output-dir", a->outputDir, "Where P writes its EXR, PNG and scene JSON (default .)");
   sub->add_option("--stats-json", a->statsJson, "Write frame counts per resolution and the last frame's time");
   sub->add_option("--local-size", a->localSize, "Work-group shape WxH (default 8x8); never changes the pixels");
+  addThreadsOption(sub);
   return {sub, [a]() { return runView(*a); }};
 }
 
