@@ -2,6 +2,7 @@
 #include "scene/json_reader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -23,6 +24,42 @@ std::string childKey(const std::string& parent, const std::string& name) {
 
 std::string indexKey(const std::string& parent, size_t index) {
   return parent + "[" + std::to_string(index) + "]";
+}
+
+std::string schemaKey(const std::string& key) {
+  std::string out;
+  bool inIndex = false;
+  for (char c : key) {
+    if (c == ']') inIndex = false;
+    if (!inIndex) out += c;
+    if (c == '[') inIndex = true;
+  }
+  return out;
+}
+
+namespace {
+std::string lowercase(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+}  // namespace
+
+bool isTypoOf(const std::string& unknown, const std::string& name) {
+  return unknown != name && nearMiss(unknown, name) &&
+         (std::min(unknown.size(), name.size()) >= 3 || lowercase(unknown) == lowercase(name));
+}
+
+bool nearMiss(const std::string& a, const std::string& b) {
+  std::string x = lowercase(a), y = lowercase(b);
+  if (x == y) return true;
+  if (x.size() > y.size()) std::swap(x, y);
+  if (y.size() - x.size() > 1) return false;
+  size_t i = 0;
+  while (i < x.size() && x[i] == y[i]) ++i;  // the first difference
+  if (x.size() < y.size()) return x.compare(i, std::string::npos, y, i + 1, std::string::npos) == 0;  // insertion
+  if (x.compare(i + 1, std::string::npos, y, i + 1, std::string::npos) == 0) return true;            // replacement
+  return i + 1 < x.size() && x[i] == y[i + 1] && x[i + 1] == y[i] &&                                 // swap
+         x.compare(i + 2, std::string::npos, y, i + 2, std::string::npos) == 0;
 }
 
 std::string formatNumber(float v) {
@@ -100,14 +137,26 @@ bool ObjectReader::has(const std::string& name) const { return value_.contains(n
 
 const json* ObjectReader::find(const std::string& name) {
   known_.push_back(name);
+  if (ctx_.keysAsked) ctx_.keysAsked->insert(schemaKey(keyOf(name)));
   const auto it = value_.find(name);
   return it == value_.end() ? nullptr : &*it;
 }
 
 const json& ObjectReader::require(const std::string& name) {
   const json* v = find(name);
-  if (!v) ctx_.fail(keyOf(name), "missing required key");
+  if (!v) {
+    for (const auto& item : value_.items())
+      if (isTypoOf(item.key(), name))
+        ctx_.fail(keyOf(name), "missing required key (is \"" + item.key() + "\" meant to be it?)");
+    ctx_.fail(keyOf(name), "missing required key");
+  }
   return *v;
+}
+
+std::string ObjectReader::nearMissOf(const std::string& unknown) const {
+  for (const std::string& name : known_)
+    if (isTypoOf(unknown, name)) return name;
+  return "";
 }
 
 float ObjectReader::getFloat(const std::string& name, float fallback) {
@@ -152,7 +201,11 @@ void ObjectReader::reportUnknown() {
     if (std::find(known_.begin(), known_.end(), item.key()) != known_.end()) continue;
     const std::string key = keyOf(item.key());
     ctx_.unknownKeys.push_back(key);
-    ctx_.warnings->push_back(ctx_.file + ": unknown key " + key + " (ignored)");
+    const std::string meant = nearMissOf(item.key());
+    if (meant.empty())
+      ctx_.warnings->push_back(ctx_.file + ": unknown key " + key + " (ignored)");
+    else
+      ctx_.nearMisses.emplace_back(key, keyOf(meant));
   }
 }
 

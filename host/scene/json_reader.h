@@ -4,7 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -21,6 +23,10 @@ struct JsonContext {
   std::string file;                      // the scene file's name as the user gave it
   std::vector<std::string>* warnings;    // Scene::warnings
   std::vector<std::string> unknownKeys;  // dotted paths of keys the schema did not ask for
+  std::set<std::string>* keysAsked = nullptr;  // when set: every key looked up, as schemaKey() writes it
+  // Unknown keys that are near misses of a key their object asked for: (key, the key it probably
+  // meant), both dotted. The loader fails on the first once the whole scene is read.
+  std::vector<std::pair<std::string, std::string>> nearMisses;
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
   void warn(const std::string& key, const std::string& what) const;
@@ -28,6 +34,14 @@ struct JsonContext {
 
 std::string childKey(const std::string& parent, const std::string& name);  // "a" + "b" -> "a.b"
 std::string indexKey(const std::string& parent, size_t index);             // "a" + 1 -> "a[1]"
+// A key as the scene-format reference names it: indices dropped, "materials[2].g" -> "materials[].g".
+std::string schemaKey(const std::string& key);
+// True when `a` and `b` differ only by letter case or by one edit (a letter inserted, deleted,
+// replaced, or two neighbours swapped), after case is ignored.
+bool nearMiss(const std::string& a, const std::string& b);
+// An unknown key that is taken for a typo of `name`: a near miss, by case at any length, by one
+// edit only when both have three letters or more ("x" is not a misspelt "g").
+bool isTypoOf(const std::string& unknown, const std::string& name);
 
 // A float as the messages print it: the shortest form that reads back (1.5, 0.0001, 1e+20).
 std::string formatNumber(float v);
@@ -64,10 +78,14 @@ class ObjectReader {
   Vec3f getVec3(const std::string& name, const Vec3f& fallback);
   Vec3f requireVec3(const std::string& name);
 
-  // Adds "FILE: unknown key KEY (ignored)" for every key never looked up.
+  // Adds "FILE: unknown key KEY (ignored)" for every key never looked up, or, for one that is a
+  // near miss of a key this object asked for ("sPP" for "spp"), records it in nearMisses: a typo
+  // that would otherwise run the default silently, perhaps a thousand times the work.
   void reportUnknown();
 
  private:
+  std::string nearMissOf(const std::string& unknown) const;  // the asked-for key it misses, or ""
+
   JsonContext& ctx_;
   const json& value_;
   std::string key_;

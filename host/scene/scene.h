@@ -4,6 +4,7 @@
 
 #include <array>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -175,6 +176,7 @@ struct Scene {
   RendererSettings renderer;
   Vec3f background{0, 0, 0};
   std::vector<std::string> warnings;  // unknown keys and other non-fatal findings
+  std::vector<std::string> overrides;  // the --set PATH=VALUE strings applied, in order
   nlohmann::json document;             // the JSON as rendered: the file with the overrides applied
 };
 
@@ -182,8 +184,10 @@ struct Scene {
 // JSON before validation. Throws InputError ("FILE: KEY: what is wrong") on any bad input.
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
 // The same from JSON text already in memory; `path` names it in messages and anchors relative paths.
+// `keysAsked`, when given, receives every key the loader looked up (present or not), as the
+// scene-format reference names it ("materials[].g"): the schema, for the documentation check.
 Scene parseScene(const std::string& jsonText, const std::string& path,
-                 const std::vector<std::string>& overrides = {});
+                 const std::vector<std::string>& overrides = {}, std::set<std::string>* keysAsked = nullptr);
 
 const char* toneMappingName(ToneMapping t);
 // "auto", "image", "buffer" or "bricks": the scene file's spelling.

@@ -89,8 +89,10 @@
 // |                         | box's longest axis              |     |             | shadow marches)            |
 // | background              | vec3: radiance of escaping rays |     | [0, 0, 0]   | >= 0                       |
 //
-// Unknown keys (anywhere, including keys of the other material type) are warnings, never errors,
-// except under --set, where a key the loader does not know is a typo and fails.
+// Unknown keys (anywhere, including keys of the other material type) are warnings, except a near
+// miss of a key the same object takes ("sPP" for "spp": json_reader.h, nearMiss), which fails, and
+// any unknown key under --set, where a key the loader does not know is a typo. Every key is
+// documented in docs/scene-format.md (checked by tests/unit/scene_format_doc_test.cpp).
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -376,7 +378,8 @@ void readResolution(ObjectReader& r, RendererSettings& s) {
                                                toInteger(r.context(), v[i], indexKey(key, i)), 1, kMaxImageSide));
 }
 
-RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::string& key) {
+// `emits`: some material emits (the lobe's firstHitSteps then serves both variants).
+RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::string& key, bool emits) {
   ObjectReader r(ctx, value, key);
   RendererSettings s;
   readResolution(r, s);
@@ -421,10 +424,12 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
   if (const json* v = r.find("lobe")) {
     ObjectReader l(ctx, *v, r.keyOf("lobe"));
     s.lobe.variant = readEnum(l, "variant", kLobeVariants, s.lobe.variant);
-    // The corrected estimator has no first-hit search and no fixed depth (lobe.h, C2).
+    // The corrected estimator has no first-hit search and no fixed depth (lobe.h, C2); the first
+    // hit's step count still marches an emitting medium's light in both variants.
     if (s.lobe.variant == LobeVariant::Corrected)
       for (const char* key : {"depthFactor", "firstHitSteps"})
-        if (l.find(key)) ctx.warn(l.keyOf(key), "applies to variant \"eq7\"; \"corrected\" ignores it");
+        if (l.find(key) && !(emits && std::string(key) == "firstHitSteps"))
+          ctx.warn(l.keyOf(key), "applies to variant \"eq7\"; \"corrected\" ignores it");
     s.lobe.depthFactor = readNonNegative(l, "depthFactor", s.lobe.depthFactor);
     s.lobe.lobePoints = readInt(l, "lobePoints", s.lobe.lobePoints, 1);
     s.lobe.lobeRadius = readNonNegative(l, "lobeRadius", s.lobe.lobeRadius);
@@ -518,10 +523,12 @@ std::string parseMessage(const json::exception& e) {
 
 }  // namespace
 
-Scene parseScene(const std::string& jsonText, const std::string& path, const std::vector<std::string>& overrides) {
+Scene parseScene(const std::string& jsonText, const std::string& path, const std::vector<std::string>& overrides,
+                 std::set<std::string>* keysAsked) {
   Scene scene;
   scene.sourcePath = path;
-  JsonContext ctx{path, &scene.warnings, {}};
+  scene.overrides = overrides;
+  JsonContext ctx{path, &scene.warnings, {}, keysAsked, {}};
 
   json doc;
   try {
@@ -546,7 +553,9 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
   readMaterials(ctx, root, scene);
   readPrimitives(ctx, root, scene);
   scene.camera = readCamera(ctx, root.require("camera"), "camera");
-  scene.renderer = readRenderer(ctx, root.require("renderer"), "renderer");
+  bool emits = false;
+  for (const Material& m : scene.materials) emits = emits || m.emission.kind != EmissionKind::None;
+  scene.renderer = readRenderer(ctx, root.require("renderer"), "renderer", emits);
   scene.background = root.getVec3("background", scene.background);
   checkNonNegative(ctx, "background", scene.background);
   root.reportUnknown();
@@ -554,8 +563,15 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
   // In a file an unknown key is a warning; on the command line it is a typo the user is waiting on.
   for (const auto& [written, key] : overridden)
     for (const std::string& unknown : ctx.unknownKeys)
-      if (key == unknown || key.rfind(unknown + ".", 0) == 0 || key.rfind(unknown + "[", 0) == 0)
-        ctx.fail("--set " + written, "not a scene setting (unknown key " + unknown + ")");
+      if (key == unknown || key.rfind(unknown + ".", 0) == 0 || key.rfind(unknown + "[", 0) == 0) {
+        std::string meant;
+        for (const auto& [miss, suggestion] : ctx.nearMisses)
+          if (miss == unknown) meant = "; did you mean " + suggestion + "?";
+        ctx.fail("--set " + written, "not a scene setting (unknown key " + unknown + meant + ")");
+      }
+  // A near miss of a known key in the file is a typo too: its default would run silently.
+  if (!ctx.nearMisses.empty())
+    ctx.fail(ctx.nearMisses.front().first, "unknown key (did you mean " + ctx.nearMisses.front().second + "?)");
 
   warnIfDark(ctx, scene);
   return scene;

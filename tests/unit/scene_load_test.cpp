@@ -387,7 +387,7 @@ TEST(SceneErrors, ErrorsAreOneLine) {
 
 TEST(SceneWarnings, UnknownKeysAreNamedAndIgnored) {
   json j = minimalScene();
-  j["camera"]["fov"] = 30;
+  j["camera"]["fieldOfView"] = 30;
   j["comment"] = "made by hand";
   j["materials"][0]["scattering"] = {1, 1, 1};  // a volume key on an emitter
   j["primitives"][1]["transform"] = {{"translate", {1, 0, 0}}};
@@ -396,11 +396,38 @@ TEST(SceneWarnings, UnknownKeysAreNamedAndIgnored) {
   EXPECT_EQ(s.warnings, (std::vector<std::string>{
                             "scenes/a.json: unknown key materials[0].scattering (ignored)",
                             "scenes/a.json: unknown key primitives[1].transform.translate (ignored)",
-                            "scenes/a.json: unknown key camera.fov (ignored)",
+                            "scenes/a.json: unknown key camera.fieldOfView (ignored)",
                             "scenes/a.json: unknown key renderer.lobe.points (ignored)",
                             "scenes/a.json: unknown key comment (ignored)",
                         }));
   EXPECT_EQ(s.camera.vfov, 45.0f);
+}
+
+// A key one slip away from a key its object takes is a typo whose default would run silently (a
+// thousand samples for "sPP"): an error naming the key it probably meant. Case slips count at any
+// length, one edit (a letter added, dropped, replaced, or two swapped) only for names of three
+// letters or more; anything further stays a warning.
+TEST(SceneErrors, NearMissKeysNameTheKeyTheyProbablyMeant) {
+  auto with = [](const std::string& object, int index, const std::string& key) {
+    json j = minimalScene();
+    json& o = index < 0 ? j[object] : j[object][index];
+    o[key] = 4;
+    return errorOf(j);
+  };
+  EXPECT_EQ(with("renderer", -1, "sPP"), "s.json: renderer.sPP: unknown key (did you mean renderer.spp?)");
+  EXPECT_EQ(with("renderer", -1, "hdr"), "s.json: renderer.hdr: unknown key (did you mean renderer.HDR?)");
+  EXPECT_EQ(with("camera", -1, "fov"), "s.json: camera.fov: unknown key (did you mean camera.vfov?)");
+  EXPECT_EQ(with("camera", -1, "vofv"), "s.json: camera.vofv: unknown key (did you mean camera.vfov?)");
+  EXPECT_EQ(with("camera", -1, "vfovv"), "s.json: camera.vfovv: unknown key (did you mean camera.vfov?)");
+  EXPECT_EQ(with("materials", 1, "densty"), "s.json: materials[1].densty: unknown key (did you mean materials[1].density?)");
+  EXPECT_EQ(with("materials", 1, "G"), "s.json: materials[1].G: unknown key (did you mean materials[1].g?)");
+  EXPECT_EQ(with("materials", 1, "h"), "(no error)");  // one edit from "g", but one letter long
+  EXPECT_EQ(with("camera", -1, "fovy"), "(no error)");  // two edits from "vfov"
+  // A required key misspelt: the missing key's message points at the one present.
+  json j = minimalScene();
+  j["materials"][1].erase("scattering");
+  j["materials"][1]["Scattering"] = {1, 1, 1};
+  EXPECT_EQ(errorOf(j), "s.json: materials[1].scattering: missing required key (is \"Scattering\" meant to be it?)");
 }
 
 TEST(SceneWarnings, HenyeyGreensteinAtPlusMinusOneIsClamped) {
@@ -448,6 +475,12 @@ TEST(SceneWarnings, EqSevenKeysUnderTheCorrectedLobe) {
             (std::vector<std::string>{
                 "s.json: renderer.lobe.depthFactor: applies to variant \"eq7\"; \"corrected\" ignores it",
                 "s.json: renderer.lobe.firstHitSteps: applies to variant \"eq7\"; \"corrected\" ignores it"}));
+  // An emitting medium's light is marched with firstHitSteps in both variants.
+  json fire = j;
+  fire["materials"][1]["emission"] = {{"color", {1, 1, 1}}};
+  EXPECT_EQ(parseScene(fire.dump(), "s.json").warnings,
+            (std::vector<std::string>{
+                "s.json: renderer.lobe.depthFactor: applies to variant \"eq7\"; \"corrected\" ignores it"}));
   j["renderer"]["lobe"]["variant"] = "eq7";
   EXPECT_TRUE(parseScene(j.dump(), "s.json").warnings.empty());
 }
@@ -508,9 +541,11 @@ TEST(SceneOverrides, BadPaths) {
   EXPECT_EQ(errorOf(minimalScene(), {"renderer.passes.0=1"}), "s.json: --set renderer.passes.0: no such key");
   // A key the loader does not know would only be a warning in a file; on the command line it is a typo.
   EXPECT_EQ(errorOf(minimalScene(), {"rendrer.spp=3"}),
-            "s.json: --set rendrer.spp: not a scene setting (unknown key rendrer)");
+            "s.json: --set rendrer.spp: not a scene setting (unknown key rendrer; did you mean renderer?)");
   EXPECT_EQ(errorOf(minimalScene(), {"camera.fov=30"}),
-            "s.json: --set camera.fov: not a scene setting (unknown key camera.fov)");
+            "s.json: --set camera.fov: not a scene setting (unknown key camera.fov; did you mean camera.vfov?)");
+  EXPECT_EQ(errorOf(minimalScene(), {"camera.fieldOfView=30"}),
+            "s.json: --set camera.fieldOfView: not a scene setting (unknown key camera.fieldOfView)");
 }
 
 // ---------------------------------------------------------------- volume paths
