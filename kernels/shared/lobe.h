@@ -305,6 +305,22 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_CONSTANT con
   return vec3_add(vec3_mul(Lb, Tv), vec3_mul(vec3_mul(opacity, lobe_albedo(m)), in_mean));
 }
 
+/* The lobe's frame (t, b, ω) about the unit view direction ω = `dir`: t is the camera's right
+ * vector made perpendicular to ω (so the frame varies smoothly across the image, header comment),
+ * b = ω × t. A direction along ±right has no such component (no camera ray is one, since every
+ * camera ray leans forward, but a caller's may be): any perpendicular frame then serves. */
+static inline void lobe_frame(vec3 dir, vec3 right, NV_PRIVATE vec3* tx, NV_PRIVATE vec3* ty) {
+  const vec3 perp = vec3_madd(right, dir, -vec3_dot(right, dir));
+  const float len = vec3_length(perp);
+  if (len > 1e-6f) {
+    *tx = vec3_scale(perp, 1.0f / len);
+  } else {
+    vec3 unused;
+    vec3_basis(dir, tx, &unused);
+  }
+  *ty = vec3_cross(dir, *tx);
+}
+
 /* Radiance of the view ray from `origin` along unit `dir`. `right` is the camera's unit right
  * vector (the lobe frame's reference, see the header comment); `dirs` holds p->lobe_points unit
  * directions about +Z. */
@@ -323,8 +339,8 @@ static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtim
   if (!medium_intersect(&s->medium, origin, dir, 0.0f, t_surf, &seg)) return Lb;
 
   /* 3. Frame (t, b, ω) from the camera's right vector; (t, b, ω) is right-handed. */
-  const vec3 tx = vec3_normalize(vec3_madd(right, dir, -vec3_dot(right, dir)));
-  const vec3 ty = vec3_cross(dir, tx);
+  vec3 tx, ty;
+  lobe_frame(dir, right, &tx, &ty);
   const int corrected = p->lobe_variant == LOBE_CORRECTED; /* else LOBE_EQ7, the host's only other variant */
   const vec3 L = corrected
                      ? lobe_radiance_corrected(KERNEL_CONTEXT_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg)

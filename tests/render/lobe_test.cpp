@@ -93,6 +93,33 @@ double hg(double g, double mu) { return (1 - g * g) / (4 * M_PI * std::pow(1 + g
 // rounding). The pinned conventions: x0 = box entry (ρ ≡ 1 > 0), c = x0 + min(df/σ̄t, rest)·ω,
 // lobe frame (t, b, ω) with t the camera's right vector made perpendicular to ω and b = ω × t,
 // P_i = c + r·d_i, cos θ_i = dot(normalize(P_i − light), −d_i), albedo = σs/σt.
+// The lobe's frame about a view direction: the camera's right vector made perpendicular to it,
+// exactly as the normalisation of that projection (so Eq. 7's pixels are what they were); for a
+// direction along ±right, which has no such component, still an orthonormal right-handed frame.
+TEST(RenderLobe, FrameIsOrthonormalEvenAlongTheRightVector) {
+  const vec3 right = vec3_make(1, 0, 0);
+  for (vec3 dir : {vec3_normalize(vec3_make(0.3f, -0.2f, 1.0f)), vec3_make(1, 0, 0), vec3_make(-1, 0, 0),
+                   vec3_normalize(vec3_make(1, 1e-8f, 0))}) {
+    vec3 t, b;
+    lobe_frame(dir, right, &t, &b);
+    for (const vec3& v : {t, b}) {
+      ASSERT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z));
+      EXPECT_NEAR(vec3_dot(v, v), 1.0f, 1e-6f);
+      EXPECT_NEAR(vec3_dot(v, dir), 0.0f, 1e-6f);
+    }
+    EXPECT_NEAR(vec3_dot(t, b), 0.0f, 1e-6f);
+    const vec3 handed = vec3_cross(t, b);  // (t, b, ω) right-handed: t × b = ω
+    EXPECT_NEAR(vec3_dot(handed, dir), 1.0f, 1e-6f);
+  }
+  const vec3 dir = vec3_normalize(vec3_make(0.3f, -0.2f, 1.0f));
+  vec3 t, b;
+  lobe_frame(dir, right, &t, &b);
+  const vec3 expected = vec3_normalize(vec3_madd(right, dir, -vec3_dot(right, dir)));
+  EXPECT_EQ(t.x, expected.x);
+  EXPECT_EQ(t.y, expected.y);
+  EXPECT_EQ(t.z, expected.z);
+}
+
 TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
   Scene scene = sceneFromJson(R"({
     "materials": [

@@ -175,6 +175,7 @@ TEST(SamplingMis, PowerHeuristic) {
   EXPECT_FLOAT_EQ(mis_power_heuristic(3.0f, 1.0f), 0.9f);
   EXPECT_FLOAT_EQ(mis_power_heuristic(1.0f, 0.0f), 1.0f);
   EXPECT_FLOAT_EQ(mis_power_heuristic(0.2f, 5.0f) + mis_power_heuristic(5.0f, 0.2f), 1.0f);
+  EXPECT_EQ(mis_power_heuristic(0.0f, 0.0f), 0.0f);  // drawable by neither: no weight, not 0/0
 }
 
 }  // namespace
