@@ -140,8 +140,8 @@ int run(const Args& a) {
   const std::string device = "native C++ (" + std::to_string(r.threads) + " threads, " NARVAL_NATIVE_FLAGS ")";
   writeExr(out.string(), r.image,
            {{"narval:algorithm", alg},
-            {"narval:spp", std::to_string(spp)},
-            {"narval:seed", std::to_string(scene.renderer.seed)},
+            {"narval:spp", spp},
+            {"narval:seed", double(scene.renderer.seed)},
             {"narval:device", device}});
 
   const majorant_grid_params& mg = ds.params.medium.majorant_grid;

@@ -1,7 +1,9 @@
 #include "app/cli_common.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <regex>
 
 #include "image/atomic_file.h"
@@ -60,7 +62,7 @@ CLI::Validator greaterThanZero() {
         char* end = nullptr;
         const double v = std::strtod(text.c_str(), &end);
         if (text.empty() || *end != '\0') return "expected a number, got '" + text + "'";
-        return v > 0 && v < 1e9 ? std::string() : "must be greater than 0, got " + text;
+        return v > 0 && std::isfinite(v) ? std::string() : "must be a finite number greater than 0, got " + text;
       },
       "NUMBER > 0");
 }
@@ -82,6 +84,26 @@ void addThreadsOption(CLI::App* sub) {
 
 void addQuietOption(CLI::App* sub, bool* quiet) {
   sub->add_flag("-q,--quiet", *quiet, "Print only errors and warnings (no progress bar, no report lines)");
+}
+
+void checkOutputWritable(const std::string& path, const std::string& option) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return;
+  const fs::path p(path);
+  std::error_code ec;
+  if (fs::is_directory(p, ec)) throw inputError(option, "", "cannot write " + path + ": it is a folder");
+  if (p.has_parent_path()) {
+    fs::create_directories(p.parent_path(), ec);
+    if (ec) throw inputError(option, "", "cannot write " + path + ": cannot create its folder: " + ec.message());
+  }
+  try {
+    AtomicFile probe(path);  // a temporary beside `path`; destroyed uncommitted, it is removed
+  } catch (const std::exception& e) {
+    std::string reason = e.what();
+    const std::string prefix = path + ": cannot write: ";
+    if (reason.rfind(prefix, 0) == 0) reason = reason.substr(prefix.size());
+    throw inputError(option, "", "cannot write " + path + ": " + reason);
+  }
 }
 
 void checkLocalSize(int lx, int ly, const cl::Device& device, const std::string& deviceName) {

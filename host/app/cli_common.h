@@ -25,7 +25,7 @@ std::string resolutionOverride(const std::string& text);
 // not CLI11's range text with a 309-digit bound.
 CLI::Validator atLeast(long long min);
 CLI::Validator between(long long min, long long max);
-CLI::Validator greaterThanZero();  // any number > 0 (and below 1e9)
+CLI::Validator greaterThanZero();  // any finite number > 0
 
 // --threads N on a subcommand that opens a device: PoCL's worker threads on a CPU device (it sets
 // POCL_MAX_PTHREAD_COUNT before the OpenCL platform is first asked for, so it must be parsed before
@@ -34,6 +34,12 @@ void addThreadsOption(CLI::App* sub);
 
 // --quiet: only errors and warnings on stderr; no progress bar and no report lines on stdout.
 void addQuietOption(CLI::App* sub, bool* quiet);
+
+// Before any work: makes `path`'s folder (as the writers would) and proves a file can be created
+// there (a temporary, removed again), so a render never runs only to fail at its last step.
+// InputError "OPTION: cannot write PATH: REASON" (exit 2) otherwise; an existing file at `path` is
+// not touched. An empty `path` (the option not given) passes.
+void checkOutputWritable(const std::string& path, const std::string& option);
 
 // Fails with "--local-size: WxH is N work-items; DEVICE takes at most M per group" (exit 2)
 // when the shape cannot be launched on the device, instead of CL_INVALID_WORK_GROUP_SIZE later.

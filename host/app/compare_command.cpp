@@ -4,13 +4,16 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "app/cli_common.h"
 #include "app/commands.h"
 #include "image/image.h"
 #include "image/image_compare.h"
@@ -22,10 +25,35 @@ namespace narval {
 namespace {
 
 struct CompareArgs {
-  std::string reference, test, tonemap = "none", heatmap, jndMap;
-  double exposure = 0.0, heatmapMax = 10.0;  // double: the JSON echoes what was typed
+  std::string reference, test, tonemap, heatmap, jndMap;  // tonemap "": the EXRs' (below)
+  std::optional<double> exposure;                          // double: the JSON echoes what was typed
+  double heatmapMax = 10.0;
   bool json = false;
 };
+
+// The display transform both EXRs record (render_exr.h: narval:exposure and narval:tone_mapping,
+// the scene's), when they record the same one: what `sweep` compared under, so `compare A B`
+// reports what `sweep` reported for the pair.
+struct RecordedDisplay {
+  bool found = false;
+  double exposure = 0.0;
+  std::string toneMapping = "none";
+};
+
+RecordedDisplay recordedDisplay(const std::string& reference, const std::string& test) {
+  const auto a = readExrAttributes(reference), b = readExrAttributes(test);
+  RecordedDisplay d;
+  for (const char* key : {"narval:exposure", "narval:tone_mapping"}) {
+    const auto x = a.find(key), y = b.find(key);
+    if (x == a.end() || y == b.end() || x->second != y->second) return d;
+  }
+  char* end = nullptr;
+  d.exposure = std::strtod(a.at("narval:exposure").c_str(), &end);
+  if (*end != '\0' || !std::isfinite(d.exposure)) return RecordedDisplay{};
+  d.toneMapping = a.at("narval:tone_mapping");
+  d.found = true;
+  return d;
+}
 
 const std::map<std::string, ToneMapping> kToneMappings = {
     {"none", ToneMapping::None}, {"reinhard", ToneMapping::Reinhard}, {"aces", ToneMapping::Aces}};
@@ -36,11 +64,6 @@ void checkPngOutput(const std::string& path, const std::string& option) {
   std::string ext = fs::path(path).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (ext != ".png") throw inputError(option, "", "the output must be a .png file, got '" + path + "'");
-}
-
-void createParent(const std::string& path) {
-  const fs::path p(path);
-  if (p.has_parent_path()) fs::create_directories(p.parent_path());
 }
 
 std::string fixed(double v, int digits) {
@@ -56,30 +79,41 @@ std::string tableRow(const char* name, const DeltaEStats& s) {
 }
 
 int runCompare(const CompareArgs& a) {
-  if (!std::isfinite(a.exposure)) throw inputError("--exposure", "", "expected a finite number of stops");
+  if (a.exposure && !std::isfinite(*a.exposure)) throw inputError("--exposure", "", "expected a finite number of stops");
   if (!(a.heatmapMax > 0.0) || !std::isfinite(a.heatmapMax))
     throw inputError("--heatmap-max", "", "expected a positive number");
   checkPngOutput(a.heatmap, "--heatmap");
   checkPngOutput(a.jndMap, "--jnd-map");
+  checkOutputWritable(a.heatmap, "--heatmap");
+  checkOutputWritable(a.jndMap, "--jnd-map");
   std::string tmName = a.tonemap;
   for (char& c : tmName) c = char(std::tolower(static_cast<unsigned char>(c)));
-  const auto tm = kToneMappings.find(tmName);
-  if (tm == kToneMappings.end())
+  if (!tmName.empty() && !kToneMappings.count(tmName))
     throw inputError("--tonemap", "", "expected none, reinhard or aces, got '" + a.tonemap + "'");
 
-  DisplaySettings display;
-  display.exposureStops = float(a.exposure);
-  display.toneMapping = tm->second;
   const ImageRGB reference = readExr(a.reference);
   const ImageRGB test = readExr(a.test);
+  // Flags win; what they leave open comes from the EXRs when both record the same transform.
+  const RecordedDisplay recorded = recordedDisplay(a.reference, a.test);
+  const bool anyFlag = a.exposure || !tmName.empty(), allFlags = a.exposure && !tmName.empty();
+  if (tmName.empty()) tmName = recorded.found ? recorded.toneMapping : "none";
+  const auto tm = kToneMappings.find(tmName);
+  if (tm == kToneMappings.end())  // a recorded name this build does not know
+    throw inputError(a.reference, "narval:tone_mapping", "unknown tone mapping '" + tmName + "'");
+  const double exposure = a.exposure ? *a.exposure : recorded.found ? recorded.exposure : 0.0;
+  const std::string source = allFlags         ? "given"
+                             : recorded.found ? (anyFlag ? "given, the rest as both EXRs record it" : "as both EXRs record it")
+                             : anyFlag        ? "given, the rest the default"
+                                              : "the default: the EXRs record no common display transform";
+  DisplaySettings display;
+  display.exposureStops = float(exposure);
+  display.toneMapping = tm->second;
   const ImageComparison c = compareImages(reference, test, display, a.reference, a.test);
 
   if (!a.heatmap.empty()) {
-    createParent(a.heatmap);
     writeDeltaEHeatmap(a.heatmap, c.dE76, c.width, c.height, float(a.heatmapMax));
   }
   if (!a.jndMap.empty()) {
-    createParent(a.jndMap);
     writeJndMap(a.jndMap, test, display, c.dE76, c.stats76.jndPercent);
   }
 
@@ -88,8 +122,9 @@ int runCompare(const CompareArgs& a) {
                                       {"test", a.test},
                                       {"width", c.width},
                                       {"height", c.height},
-                                      {"exposure", a.exposure},
+                                      {"exposure", exposure},
                                       {"tonemap", tm->first},
+                                      {"display_transform", source},
                                       {"mean_dE76", c.stats76.mean},
                                       {"p95_dE76", c.stats76.p95},
                                       {"max_dE76", c.stats76.max},
@@ -103,8 +138,8 @@ int runCompare(const CompareArgs& a) {
   }
   std::cout << "reference " << a.reference << "\n"
             << "test      " << a.test << "\n"
-            << "          " << c.width << "x" << c.height << ", exposure " << fixed(a.exposure, 2)
-            << " stops, tone mapping " << tm->first << "\n\n";
+            << "          " << c.width << "x" << c.height << ", exposure " << fixed(exposure, 2)
+            << " stops, tone mapping " << tm->first << " (" << source << ")\n\n";
   char header[160];
   std::snprintf(header, sizeof header, "%-8s %10s %10s %10s %10s\n", "", "mean", "p95", "max", "JND%");
   std::cout << header << tableRow("dE76", c.stats76) << tableRow("dE2000", c.stats2000)
@@ -122,8 +157,12 @@ Command addCompareCommand(CLI::App& app) {
   auto a = std::make_shared<CompareArgs>();
   sub->add_option("REF.exr", a->reference, "Reference image (linear EXR)")->required();
   sub->add_option("TEST.exr", a->test, "Image to compare with it (same size)")->required();
-  sub->add_option("--exposure", a->exposure, "Exposure in stops applied to both before comparing (default 0)");
-  sub->add_option("--tonemap", a->tonemap, "Tone mapping applied to both: none (default) | reinhard | aces");
+  sub->add_option("--exposure", a->exposure,
+                  "Exposure in stops applied to both before comparing (default: the EXRs' narval:exposure when "
+                  "both record the same, else 0)");
+  sub->add_option("--tonemap", a->tonemap,
+                  "Tone mapping applied to both: none | reinhard | aces (default: the EXRs' narval:tone_mapping "
+                  "when both record the same, else none)");
   sub->add_option("--heatmap", a->heatmap, "Write the ΔE76 heat map with a legend bar as PNG");
   sub->add_option("--heatmap-max", a->heatmapMax, "ΔE at the top of the heat map's scale (default 10)");
   sub->add_option("--jnd-map", a->jndMap,

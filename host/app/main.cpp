@@ -6,9 +6,11 @@
 
 #include "app/commands.h"
 #include "cl/cl_runtime.h"
+#include "render/render_exr.h"
 #include "scene/input_error.h"
 
 int main(int argc, char** argv) {
+  narval::recordCommandLine(argc, argv);  // for the EXRs' narval:command_line
   CLI::App app{"narval: OpenCL renderer for participating media"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("narval ") + NARVAL_VERSION);

@@ -14,6 +14,7 @@
 #include "app/progress_bar.h"
 #include "display/display_server.h"
 #include "image/image.h"
+#include "image/staged_files.h"
 #include "render/pathtrace_renderer.h"
 #include "render/realtime_renderer.h"
 #include "render/render_common.h"
@@ -144,7 +145,10 @@ int runRender(const RenderArgs& a) {
   fs::path out = a.out.empty() ? fs::path(fs::path(a.scene).stem().string() + ".exr") : fs::path(a.out);
   if (out.extension() != ".exr") throw inputError("-o", "", "the output must be an .exr file, got '" + a.out + "'");
   const fs::path png = fs::path(out).replace_extension(".png");
-  if (out.has_parent_path()) fs::create_directories(out.parent_path());
+  // Every output is proven writable before any work (folders made as the writers would make them).
+  checkOutputWritable(out.string(), "-o");
+  checkOutputWritable(png.string(), "-o");
+  checkOutputWritable(a.statsJson, "--stats-json");
 
   // --resume: the accumulator of an earlier render of the same settings at the output path.
   std::string majorant = a.majorant;
@@ -235,8 +239,10 @@ int runRender(const RenderArgs& a) {
     return kExitInterrupted;
   }
 
-  writeRenderExr(out.string(), r, scene);
-  writePng(png.string(), r.image, scene.renderer.exposure, scene.renderer.toneMapping);
+  // The EXR, the PNG and the stats land together or not at all (staged_files.h).
+  StagedFiles staged;
+  writeRenderExr(staged.stage(out.string()), r, scene);
+  writePng(staged.stage(png.string()), r.image, scene.renderer.exposure, scene.renderer.toneMapping);
   if (!a.statsJson.empty()) {
     nlohmann::json j = statsJson(s, scene);
     if (a.frames > 0) j["ms_per_frame"] = framesJson(s.frames);
@@ -245,8 +251,9 @@ int runRender(const RenderArgs& a) {
       j["collisions_real"] = s.collisionsReal;
       j["density_lookups"] = s.densityLookups;
     }
-    writeTextAtomic(a.statsJson, j.dump(2) + "\n");
+    writeTextAtomic(staged.stage(a.statsJson), j.dump(2) + "\n");
   }
+  staged.commit();
 
   for (const std::string& w : statusWarnings(s.status)) std::cerr << "narval: warning: " << w << "\n";
   if (s.interrupted) {

@@ -10,6 +10,7 @@
 
 #include "app/cli_common.h"
 #include "app/commands.h"
+#include "render/render_exr.h"
 #include "app/progress_bar.h"
 #include "image/image.h"
 #include "image/image_compare.h"
@@ -89,6 +90,8 @@ int runSweepCommand(const SweepArgs& a) {
     reference = readExr(a.reference);
     checkSweepReference(scene, reference, a.reference);
   }
+  // Last of the checks (it makes the folder, so nothing else may refuse after it): the folder takes files.
+  checkOutputWritable((dir / "sweep.json").string(), "-o");
   ClRuntime rt(a.device);
 
   // ---- render
@@ -110,11 +113,7 @@ int runSweepCommand(const SweepArgs& a) {
   auto onRow = [&](const SweepRow& row) {
     const RenderStats& st = row.stats;
     const fs::path exr = dir / sweepFileName(parameter, row.value);
-    writeExr(exr.string(), row.image,
-             {{"narval:algorithm", st.algorithm}, {"narval:spp", std::to_string(st.spp)},
-              {"narval:bounces", std::to_string(st.bounces)}, {"narval:seed", std::to_string(scene.renderer.seed)},
-              {"narval:scene", scene.sourcePath}, {"narval:device", st.device},
-              {"narval:seconds", std::to_string(st.seconds)}});
+    writeExr(exr.string(), row.image, renderAttributes(st, scene));  // the row's spp and bounces from its stats
     for (const std::string& w : statusWarnings(st.status))
       std::cerr << "narval: warning: " << exr.string() << ": " << w << "\n";
     std::printf("%-14s %10.3f s", sweepLabel(parameter, row.value).c_str(), row.seconds);

@@ -52,6 +52,9 @@ int runView(const ViewArgs& a) {
       throw inputError("--screenshot", "", "needs --script or --frames (the screenshot is of the last frame)");
     run.screenshot = a.screenshot;
   }
+  checkOutputWritable(a.screenshot, "--screenshot");
+  checkOutputWritable(a.statsJson, "--stats-json");
+  checkOutputWritable((fs::path(a.outputDir) / "view.exr").string(), "--output-dir");  // where P writes
   ImageRGB reference;
   ViewerOptions options;
   if (!a.reference.empty()) {

@@ -7,16 +7,24 @@
 #include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
+#include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
+#include <ImfStringVectorAttribute.h>
 #include <IexBaseExc.h>
 
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 #include "image/atomic_file.h"
 #include "image/image.h"
@@ -85,8 +93,7 @@ std::unique_ptr<Imf::InputFile> openExr(const std::string& path) {
 
 }  // namespace
 
-void writeExr(const std::string& path, const ImageRGB& image,
-              const std::vector<std::pair<std::string, std::string>>& attributes,
+void writeExr(const std::string& path, const ImageRGB& image, const std::vector<ExrAttribute>& attributes,
               const std::vector<ExrChannel>& extra) {
   if (image.width <= 0 || image.height <= 0)
     throw std::runtime_error(writeErrorMessage(path, "empty image (" + std::to_string(image.width) + "x" +
@@ -104,11 +111,20 @@ void writeExr(const std::string& path, const ImageRGB& image,
   header.channels().insert("G", Imf::Channel(Imf::FLOAT));
   header.channels().insert("B", Imf::Channel(Imf::FLOAT));
   for (const ExrChannel& c : extra) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
-  for (const auto& [name, value] : attributes) {
+  for (const ExrAttribute& a : attributes) {
     try {
-      header.insert(name, Imf::StringAttribute(value));
+      std::visit(
+          [&](const auto& v) {
+            using T = std::decay_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, std::string>) header.insert(a.name, Imf::StringAttribute(v));
+            else if constexpr (std::is_same_v<T, int>) header.insert(a.name, Imf::IntAttribute(v));
+            else if constexpr (std::is_same_v<T, float>) header.insert(a.name, Imf::FloatAttribute(v));
+            else if constexpr (std::is_same_v<T, double>) header.insert(a.name, Imf::DoubleAttribute(v));
+            else header.insert(a.name, Imf::StringVectorAttribute(v));
+          },
+          a.value);
     } catch (const std::exception& e) {
-      throw std::runtime_error(writeErrorMessage(path, "attribute \"" + name + "\": " + oneLine(e.what())));
+      throw std::runtime_error(writeErrorMessage(path, "attribute \"" + a.name + "\": " + oneLine(e.what())));
     }
   }
 
@@ -203,9 +219,29 @@ std::map<std::string, std::string> readExrAttributes(const std::string& path) {
   auto file = openExr(path);
   std::map<std::string, std::string> result;
   const Imf::Header& header = file->header();
+  auto shortest = [](double v, int maxDigits) {  // the fewest digits that read back
+    char buf[40];
+    for (int digits = 1; digits <= maxDigits; ++digits) {
+      std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+      if (maxDigits == 9 ? std::strtof(buf, nullptr) == float(v) : std::strtod(buf, nullptr) == v) break;
+    }
+    return std::string(buf);
+  };
   for (auto it = header.begin(); it != header.end(); ++it) {
-    if (std::strcmp(it.attribute().typeName(), Imf::StringAttribute::staticTypeName()) == 0)
-      result[it.name()] = static_cast<const Imf::StringAttribute&>(it.attribute()).value();
+    const Imf::Attribute& a = it.attribute();
+    if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&a)) {
+      result[it.name()] = s->value();
+    } else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&a)) {
+      result[it.name()] = std::to_string(i->value());
+    } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&a)) {
+      result[it.name()] = shortest(f->value(), 9);
+    } else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&a)) {
+      result[it.name()] = shortest(d->value(), 17);
+    } else if (const auto* v = dynamic_cast<const Imf::StringVectorAttribute*>(&a)) {
+      std::string text;
+      for (size_t k = 0; k < v->value().size(); ++k) text += (k ? "\n" : "") + v->value()[k];
+      result[it.name()] = text;
+    }
   }
   return result;
 }

@@ -1,9 +1,11 @@
 // image.h: linear RGB float images, EXR and PNG output, display transform.
 #pragma once
 
-#include <map>
 #include <cstdint>
+#include <map>
 #include <string>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "scene/scene.h"
@@ -23,19 +25,27 @@ struct ExrChannel {
   std::vector<float> values;
 };
 
-// 32-bit float linear RGB EXR; `attributes` become string attributes in the header (spp, seed...);
-// `extra` channels are stored beside R, G and B (viewers show them as layers).
+// A header attribute, stored with the OpenEXR type of its value: string, int, float, double or
+// stringvector (what other tools read typed: pbrt-v4's samplesPerPixel is an int).
+struct ExrAttribute {
+  using Value = std::variant<std::string, int, float, double, std::vector<std::string>>;
+  std::string name;
+  Value value;
+};
+
+// 32-bit float linear RGB EXR with `attributes` in the header; `extra` channels are stored beside
+// R, G and B (viewers show them as layers).
 // Written to a temporary file beside `path` and renamed, so a failure never leaves a broken file
 // and never touches an existing `path`; it throws std::runtime_error "PATH: cannot write: REASON".
-void writeExr(const std::string& path, const ImageRGB& image,
-              const std::vector<std::pair<std::string, std::string>>& attributes = {},
+void writeExr(const std::string& path, const ImageRGB& image, const std::vector<ExrAttribute>& attributes = {},
               const std::vector<ExrChannel>& extra = {});
 // Reads R, G and B as 32-bit float (half or uint channels are converted) from any data window;
 // the result is the data window's size. A missing, unreadable or corrupt file, or a missing R, G or
 // B channel, throws InputError "PATH: what".
 ImageRGB readExr(const std::string& path);
-// The string attributes of an EXR header (what writeExr's `attributes` put there), by name;
-// throws InputError like readExr.
+// The attributes of an EXR header that writeExr can write, by name, as text: strings as they are,
+// ints in decimal, floats and doubles in the fewest digits that read back, string vectors one
+// element per line; throws InputError like readExr.
 std::map<std::string, std::string> readExrAttributes(const std::string& path);
 // The named channels as 32-bit float, width*height values each in the data window's size; a
 // missing channel throws InputError "PATH: no NAME channel (channels: ...)", like readExr.

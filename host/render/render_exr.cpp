@@ -1,6 +1,7 @@
 #include "render/render_exr.h"
 
 #include <cstdio>
+#include <ctime>
 #include <stdexcept>
 
 #include "cl/cl_runtime.h"
@@ -38,19 +39,61 @@ std::string renderKey(const Scene& scene) {
   return hex;
 }
 
-std::vector<std::pair<std::string, std::string>> renderAttributes(const RenderStats& s, const Scene& scene) {
-  return {{"narval:algorithm", s.algorithm},
-          {"narval:spp", std::to_string(s.spp)},
-          {"narval:bounces", std::to_string(s.bounces)},
-          {"narval:seed", std::to_string(scene.renderer.seed)},
+namespace {
+std::string& commandLineStore() {
+  static std::string text;
+  return text;
+}
+
+// One argument as a POSIX shell reads it back: bare when it is safe, else in single quotes.
+std::string shellQuoted(const std::string& arg) {
+  const bool safe = !arg.empty() && arg.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                          "0123456789_-+=./:,@%") == std::string::npos;
+  if (safe) return arg;
+  std::string out = "'";
+  for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+}  // namespace
+
+void recordCommandLine(int argc, const char* const* argv) {
+  std::string text;
+  for (int i = 0; i < argc; ++i) text += (i ? " " : "") + shellQuoted(argv[i]);
+  commandLineStore() = text;
+}
+
+const std::string& recordedCommandLine() { return commandLineStore(); }
+
+std::vector<ExrAttribute> renderAttributes(const RenderStats& s, const Scene& scene) {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{}, utc{};
+  localtime_r(&now, &local);
+  gmtime_r(&now, &utc);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y:%m:%d %H:%M:%S", &local);
+  // UTC = local + utcOffset (OpenEXR's ImfStandardAttributes.h): mktime reads both as local time.
+  const float utcOffset = float(std::difftime(std::mktime(&utc), std::mktime(&local)));
+  return {{"renderTimeSeconds", float(s.seconds)},
+          {"samplesPerPixel", s.spp},
+          {"capDate", std::string(date)},
+          {"utcOffset", utcOffset},
+          {"narval:algorithm", s.algorithm},
+          {"narval:spp", s.spp},
+          {"narval:bounces", s.bounces},
+          {"narval:seed", double(scene.renderer.seed)},  // an unsigned 32-bit seed: exact in a double
           {"narval:scene", scene.sourcePath},
           {"narval:device", s.device},
-          {"narval:seconds", std::to_string(s.seconds)},
-          {"narval:status", std::to_string(s.status)},
+          {"narval:seconds", s.seconds},
+          {"narval:status", int(s.status)},
           {"narval:render_key", renderKey(scene)},
           // The path tracer's samples also depend on these (RenderOptions): --resume keeps them.
           {"narval:majorant", s.majorant},
-          {"narval:majorant_resolution", std::to_string(s.majorantResolution)}};
+          {"narval:majorant_resolution", s.majorantResolution},
+          {"narval:exposure", scene.renderer.exposure},
+          {"narval:tone_mapping", std::string(toneMappingName(scene.renderer.toneMapping))},
+          {"narval:version", std::string(NARVAL_VERSION)},
+          {"narval:command_line", recordedCommandLine()},
+          {"narval:overrides", scene.overrides}};
 }
 
 void writeRenderExr(const std::string& path, const RenderResult& r, const Scene& scene) {

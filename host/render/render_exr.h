@@ -19,8 +19,20 @@ namespace narval {
 // camera.speed. Equal keys: the same samples, sample index for sample index.
 std::string renderKey(const Scene& scene);
 
-// The header attributes of a render's EXR ("narval:spp", "narval:render_key", ...).
-std::vector<std::pair<std::string, std::string>> renderAttributes(const RenderStats& stats, const Scene& scene);
+// The command line narval was started with, shell-quoted (main records it once; "" until then):
+// what a render's EXR names as the command that made it.
+void recordCommandLine(int argc, const char* const* argv);
+const std::string& recordedCommandLine();
+
+// The header attributes of a render's EXR, numbers typed as numbers:
+// - pbrt-v4's, which image tools read: renderTimeSeconds (float), samplesPerPixel (int);
+// - OpenEXR's standard capDate ("YYYY:MM:DD hh:mm:ss", local time) and utcOffset (float seconds,
+//   UTC = local time + utcOffset);
+// - narval's: algorithm, spp, bounces, seed, scene, device, seconds, status, render_key, majorant,
+//   majorant_resolution (what --resume checks), exposure and tone_mapping (the scene's display
+//   transform, which `narval compare` applies by default), version, command_line and overrides
+//   (the --set strings, a string vector).
+std::vector<ExrAttribute> renderAttributes(const RenderStats& stats, const Scene& scene);
 
 // Writes result.image to `path` (atomically) with renderAttributes and, for the path tracer, the
 // accumulator as six more channels: accum_sum.{R,G,B} and accum_comp.{R,G,B}.

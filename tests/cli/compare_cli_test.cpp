@@ -95,9 +95,10 @@ TEST_F(CompareCli, JsonKeysAndValuesOnAConstructedPair) {
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
   std::sort(keys.begin(), keys.end());
-  EXPECT_EQ(keys, (std::vector<std::string>{"exposure", "height", "jnd2000_pct", "jnd76_pct", "max_dE2000", "max_dE76",
-                                            "mean_dE2000", "mean_dE76", "p95_dE2000", "p95_dE76", "reference", "test",
-                                            "tonemap", "width"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"display_transform", "exposure", "height", "jnd2000_pct", "jnd76_pct",
+                                            "max_dE2000", "max_dE76", "mean_dE2000", "mean_dE76", "p95_dE2000",
+                                            "p95_dE76", "reference", "test", "tonemap", "width"}));
+  EXPECT_EQ(j["display_transform"], "the default: the EXRs record no common display transform");
   EXPECT_EQ(j["reference"], "ref.exr");
   EXPECT_EQ(j["test"], "test.exr");
   EXPECT_EQ(j["exposure"], 0.0);

@@ -38,13 +38,13 @@ TEST_F(FlagsCli, OutOfRangeValuesReadLikeTheSceneLoader) {
   expectRefused("render s.json --seed 4294967296", "narval: --seed: must be between 0 and 4294967295, got 4294967296\n");
   expectRefused("render s.json --samples-per-pass 0", "narval: --samples-per-pass: must be at least 1, got 0\n");
   expectRefused("render s.json --majorant-resolution -2", "narval: --majorant-resolution: must be at least 0, got -2\n");
-  expectRefused("render s.json --write-partial-images 0", "narval: --write-partial-images: must be greater than 0, got 0\n");
+  expectRefused("render s.json --write-partial-images 0", "narval: --write-partial-images: must be a finite number greater than 0, got 0\n");
   expectRefused("render s.json --write-partial-images soon",
                 "narval: --write-partial-images: expected a number, got 'soon'\n");
   expectRefused("render s.json --threads 0", "narval: --threads: must be between 1 and 4096, got 0\n");
   expectRefused("sweep s.json -o sw --spp 1 --seed -1", "narval: --seed: must be between 0 and 4294967295, got -1\n");
   expectRefused("make-cloud c.vdb --resolution 4", "narval: --resolution: must be between 8 and 2048, got 4\n");
-  expectRefused("view s.json --target-ms -5", "narval: --target-ms: must be greater than 0, got -5\n");
+  expectRefused("view s.json --target-ms -5", "narval: --target-ms: must be a finite number greater than 0, got -5\n");
 }
 
 // --spp has no meaning for the real-time algorithms (one estimate per pixel per frame); --bounces

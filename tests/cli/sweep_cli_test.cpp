@@ -233,3 +233,42 @@ TEST_F(SweepCli, BadInputWritesNothing) {
 
 }  // namespace
 }  // namespace narval
+
+namespace narval {
+namespace {
+
+// `compare A B` reports what `sweep` reported for the same pair: both apply the display transform
+// of the scene (which the sweep's EXRs record), so compare's default on the reference and a row
+// gives the row's ΔE in sweep.json exactly; and the transform it chose is printed.
+TEST_F(SweepCli, CompareOfARowAgreesWithTheSweep) {
+  nlohmann::json scene = nlohmann::json::parse(test::readFile(dir_ / "scene.json"));
+  scene["renderer"]["toneMapping"] = "aces";
+  scene["renderer"]["exposure"] = 1.5;
+  write("aces.json", scene.dump());
+  const test::RunResult r = run("sweep aces.json --spp 1,16 --resolution 24x12 -o out");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json sweep = nlohmann::json::parse(test::readFile(dir_ / "out" / "sweep.json"));
+  const test::RunResult c = run("compare out/spp_00016.exr out/spp_00001.exr --json");
+  ASSERT_EQ(c.code, 0) << c.err;
+  const nlohmann::json j = nlohmann::json::parse(c.out);
+  EXPECT_EQ(j["tonemap"], "aces");
+  EXPECT_EQ(j["exposure"], 1.5);
+  EXPECT_EQ(j["display_transform"], "as both EXRs record it");
+  bool found = false;
+  for (const nlohmann::json& row : sweep["rows"])
+    if (row["value"] == 1) {
+      found = true;
+      EXPECT_EQ(row["mean_dE76"].get<double>(), j["mean_dE76"].get<double>());
+      EXPECT_EQ(row["jnd76_pct"].get<double>(), j["jnd76_pct"].get<double>());
+    }
+  EXPECT_TRUE(found) << sweep.dump();
+  // A flag overrides its half of the transform; the table names where the transform came from.
+  const test::RunResult t = run("compare out/spp_00016.exr out/spp_00001.exr --tonemap none");
+  ASSERT_EQ(t.code, 0) << t.err;
+  EXPECT_NE(t.out.find("exposure 1.50 stops, tone mapping none (given, the rest as both EXRs record it)"),
+            std::string::npos)
+      << t.out;
+}
+
+}  // namespace
+}  // namespace narval

@@ -149,7 +149,9 @@ TEST_F(ViewCli, MouseAndKeysOfTheWindowDriveTheSameControls) {
             "' view fog.json --algorithm pathtrace --set renderer.spp=4 --frames 9 --target-ms 1e9 "
             "--output-dir snaps --stats-json stats.json > view.out 2> view.err &\n"
             "viewer=$!\n"
-            "window=$(xdotool search --sync --onlyvisible --name 'narval view' | head -n 1)\n"
+            // Bounded: a viewer that exits before its window shows must fail the test, not hang it.
+            "window=$(timeout 120 xdotool search --sync --onlyvisible --name 'narval view' | head -n 1)\n"
+            "[ -n \"$window\" ] || { wait $viewer; exit 3; }\n"
             "sleep 1\n"
             "xdotool mousemove --window \"$window\" 20 24 mousedown 1\n"
             "xdotool mousemove --window \"$window\" 40 24 mouseup 1\n"

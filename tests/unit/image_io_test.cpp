@@ -4,6 +4,10 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfStringVectorAttribute.h>
+#include <ImfIntAttribute.h>
+#include <ImfFloatAttribute.h>
+#include <ImfDoubleAttribute.h>
 #include <ImfOutputFile.h>
 #include <half.h>
 #include <gtest/gtest.h>
@@ -282,7 +286,15 @@ TEST(ExrTest, RoundTripIsBitExactWithAttributes) {
   for (size_t i = 0; i < special.size(); ++i) image.rgb[i * 2] = special[i];
   const std::vector<std::pair<std::string, std::string>> attributes = {
       {"spp", "1024"}, {"seed", "7"}, {"narval.scene", "clouds/a b.json"}, {"empty", ""}};
-  narval::writeExr(path, image, attributes);
+  std::vector<narval::ExrAttribute> typed;
+  for (const auto& [name, value] : attributes) typed.push_back({name, value});
+  // Numbers stored typed, read back as the fewest digits that give the same value.
+  typed.push_back({"count", 42});
+  typed.push_back({"ratio", 0.1f});
+  typed.push_back({"seconds", 0.1});
+  typed.push_back({"big", 4294967295.0});
+  typed.push_back({"list", std::vector<std::string>{"a=1", "b c"}});
+  narval::writeExr(path, image, typed);
 
   const ImageRGB back = narval::readExr(path);
   ASSERT_EQ(back.width, 7);
@@ -291,8 +303,20 @@ TEST(ExrTest, RoundTripIsBitExactWithAttributes) {
   for (size_t i = 0; i < image.rgb.size(); ++i)
     ASSERT_EQ(bits(back.rgb[i]), bits(image.rgb[i])) << "index " << i << " value " << image.rgb[i];
 
-  const std::map<std::string, std::string> expected(attributes.begin(), attributes.end());
+  std::map<std::string, std::string> expected(attributes.begin(), attributes.end());
+  expected.insert({{"count", "42"}, {"ratio", "0.1"}, {"seconds", "0.1"}, {"big", "4294967295"}, {"list", "a=1\nb c"}});
+  // Every header has OpenEXR's two float attributes besides (their defaults, 1).
+  expected.insert({{"pixelAspectRatio", "1"}, {"screenWindowWidth", "1"}});
   EXPECT_EQ(narval::readExrAttributes(path), expected);
+  {
+    Imf::InputFile typedFile(path.c_str());
+    const Imf::Header& h = typedFile.header();
+    ASSERT_NE(h.findTypedAttribute<Imf::IntAttribute>("count"), nullptr);
+    ASSERT_NE(h.findTypedAttribute<Imf::FloatAttribute>("ratio"), nullptr);
+    ASSERT_NE(h.findTypedAttribute<Imf::DoubleAttribute>("seconds"), nullptr);
+    ASSERT_NE(h.findTypedAttribute<Imf::StringVectorAttribute>("list"), nullptr);
+    EXPECT_EQ(h.findTypedAttribute<Imf::DoubleAttribute>("big")->value(), 4294967295.0);
+  }
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"round.exr"});  // no temporary left
 
   // 32-bit float R, G, B, ZIP compressed.
