@@ -9,9 +9,17 @@ cd "$(dirname "$0")/.."
 packages=(build-essential cmake pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libopenexr-dev libpng-dev
-  nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+  nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev
   clang libclang-rt-dev
   libglfw3-dev libglm-dev libgl1-mesa-dri libglx-mesa0 xvfb xauth xdotool)
+
+# The package names are Debian's (12, bookworm) and Ubuntu's; elsewhere say so and build with
+# whatever is installed (CMake names anything missing).
+if ! command -v dpkg-query >/dev/null || ! grep -qiE '^(ID|ID_LIKE)=.*(debian|ubuntu)' /etc/os-release 2>/dev/null; then
+  echo "setup: not Debian or Ubuntu; install the equivalents of these Debian packages yourself:" >&2
+  echo "  ${packages[*]}" >&2
+  packages=()
+fi
 
 missing=()
 for p in "${packages[@]}"; do

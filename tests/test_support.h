@@ -19,6 +19,17 @@
 
 #include "scene/input_error.h"
 
+// A device test on a machine without an OpenCL device skips, saying so; with NARVAL_REQUIRE_DEVICE=1
+// (CI sets it) a missing device fails instead, so a broken PoCL install cannot turn the device tests
+// into a row of silent skips.
+#define NARVAL_SKIP_WITHOUT_DEVICE()                                                                \
+  do {                                                                                              \
+    const char* require_ = std::getenv("NARVAL_REQUIRE_DEVICE");                                    \
+    if (require_ && std::string(require_) == "1")                                                   \
+      FAIL() << "no OpenCL platform or device on this machine, and NARVAL_REQUIRE_DEVICE=1";        \
+    GTEST_SKIP() << "no OpenCL platform or device on this machine (install pocl-opencl-icd)";       \
+  } while (0)
+
 namespace narval::test {
 
 // The message of the InputError `fn` throws ("" and a test failure if it throws anything else or

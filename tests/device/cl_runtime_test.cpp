@@ -30,10 +30,9 @@ using narval::test::TempDir;
 
 namespace {
 
-#define SKIP_WITHOUT_DEVICES()                                                          \
-  do {                                                                                  \
-    if (listDevices().empty())                                                          \
-      GTEST_SKIP() << "no OpenCL platform or device on this machine (install pocl-opencl-icd)"; \
+#define SKIP_WITHOUT_DEVICES()                \
+  do {                                        \
+    if (listDevices().empty()) NARVAL_SKIP_WITHOUT_DEVICE(); \
   } while (0)
 
 // Runs cache_probe over n items and returns what it wrote.
@@ -196,6 +195,32 @@ TEST(Devices, NoPlatformGivesAnEmptyListAndAClearError) {
   if (out.find("[  SKIPPED ] 1 test") != std::string::npos) GTEST_SKIP() << out;
   EXPECT_EQ(status, 0) << out;
   EXPECT_NE(out.find("[  PASSED  ] 1 test"), std::string::npos) << out;
+}
+
+// Without a device a device test skips, unless NARVAL_REQUIRE_DEVICE=1 (as in CI) makes that a
+// failure: this binary again, with no ICD, on a test guarded by SKIP_WITHOUT_DEVICES.
+TEST(Devices, RequireDeviceTurnsTheSkipIntoAFailure) {
+  const fs::path self = fs::read_symlink("/proc/self/exe");
+  TempDir dir;
+  const fs::path log = dir.path() / "child.log";
+  auto runChild = [&](const std::string& require) {
+    const std::string cmd = "env -u NARVAL_REQUIRE_DEVICE " + require + " OCL_ICD_VENDORS='" +
+                            (dir.path() / "none").string() + "' '" + self.string() +
+                            "' --gtest_filter=Devices.SelectsByIndex > '" + log.string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    return std::make_pair(status, readFile(log));
+  };
+  const auto [skipStatus, skipped] = runChild("");
+  if (skipped.find("[  PASSED  ] 1 test") != std::string::npos)
+    GTEST_SKIP() << "the ICD loader ignored OCL_ICD_VENDORS: " << skipped;
+  EXPECT_EQ(skipStatus, 0) << skipped;
+  EXPECT_NE(skipped.find("[  SKIPPED ] 1 test"), std::string::npos) << skipped;
+  const auto [failStatus, failed] = runChild("NARVAL_REQUIRE_DEVICE=1");
+  EXPECT_NE(failStatus, 0) << failed;
+  EXPECT_NE(failed.find("no OpenCL platform or device on this machine, and NARVAL_REQUIRE_DEVICE=1"),
+            std::string::npos)
+      << failed;
+  EXPECT_NE(failed.find("[  FAILED  ] 1 test"), std::string::npos) << failed;
 }
 
 TEST(Devices, JsonParsesWithEveryKey) {

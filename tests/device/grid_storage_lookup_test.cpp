@@ -41,6 +41,7 @@
 #include "shared/structs.h"
 #include "volume/brick_grid.h"
 #include "volume/grid.h"
+#include "test_support.h"
 
 namespace narval {
 const std::map<std::string, std::string>& testKernelSources();
@@ -120,7 +121,7 @@ class GridStorageLookup : public testing::Test {
     rt_ = nullptr;
   }
   void SetUp() override {
-    if (!rt_) GTEST_SKIP() << "no OpenCL platform or device on this machine (install pocl-opencl-icd)";
+    if (!rt_) NARVAL_SKIP_WITHOUT_DEVICE();
   }
 
   // grid_density on the device at `pts`, in `storage`.

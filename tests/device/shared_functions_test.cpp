@@ -28,6 +28,7 @@
 #include "shared/sampling.h"
 #include "shared/tracking.h"
 #include "unit/host_context.h"
+#include "test_support.h"
 
 namespace narval {
 const std::map<std::string, std::string>& testKernelSources();
@@ -114,7 +115,7 @@ class SharedOnDevice : public testing::Test {
     rt_ = nullptr;
   }
   void SetUp() override {
-    if (!rt_) GTEST_SKIP() << "no OpenCL platform or device on this machine (install pocl-opencl-icd)";
+    if (!rt_) NARVAL_SKIP_WITHOUT_DEVICE();
   }
 
   template <typename T>

@@ -12,6 +12,7 @@
 
 #include "cl/cl_runtime.h"
 #include "device/struct_layout.cl"
+#include "test_support.h"
 
 namespace narval {
 const std::map<std::string, std::string>& testKernelSources();
@@ -63,8 +64,7 @@ TEST(StructLayoutHost, SizesAreMultiplesOf16) {
 }
 
 TEST(StructLayoutOnDevice, MatchesTheHost) {
-  if (narval::listDevices().empty())
-    GTEST_SKIP() << "no OpenCL platform or device on this machine (install pocl-opencl-icd)";
+  if (narval::listDevices().empty()) NARVAL_SKIP_WITHOUT_DEVICE();
   narval::ClRuntime rt("");
   cl::Program program = narval::buildProgram(rt, "struct_layout.cl", "", &narval::testKernelSources());
   const std::vector<LayoutValue> host = hostLayout();
