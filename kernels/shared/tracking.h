@@ -179,6 +179,14 @@ static inline int tracking_walk_step(NV_PRIVATE tracking_walk* w, NV_GLOBAL cons
   }
 }
 
+/* Both walks start at the segment's entry: o + t·d becomes their origin and the walk's parameter
+ * s = t' − t starts at 0. Stepping t itself, the steps would be added to the distance from the
+ * ray's origin: a camera 10⁶ units away has an ulp of 0.06 there, so steps of 1/σ̄ below half of
+ * it round back to t and, where the medium is empty under its majorant, the walk stands still
+ * until its cap (tests/render/tracking_far_test.cpp). From the entry, s grows from 0 in steps it
+ * can hold; a collision is reported as t + s. */
+static inline vec3 tracking_entry(vec3 o, vec3 d, float t) { return vec3_madd(o, d, t); }
+
 /* Walks o + t·d (index-space origin and direction; t is the world-space ray parameter because d is
  * the world direction mapped by the same affine map) from t to t_max. On TRACK_SCATTERED, *t_out
  * is the collision and *beta has been reweighted (chromatic media only). */
@@ -193,14 +201,15 @@ static inline int tracking_delta(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, 
   if (!(m->majorant > 0.0f)) return TRACK_ESCAPED;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
   const int grey = TRACKING_GREY(m);
-  tracking_walk w = tracking_walk_begin(m, TRACKING_USE_MAJORANT_GRID(m), o, d, t, t_max);
+  const vec3 entry = tracking_entry(o, d, t);
+  tracking_walk w = tracking_walk_begin(m, TRACKING_USE_MAJORANT_GRID(m), entry, d, 0.0f, t_max - t);
   for (int step = 0; step < TRACKING_MAX_STEPS; ++step) {
     if (!tracking_walk_step(&w, GRID_MAJORANTS, sample_exponential(rng_uniform(rng), 1.0f), status))
       return TRACK_ESCAPED;
     const float sigma_bar = w.bar;
     TRACK_COUNT(tentative);
     TRACK_COUNT(lookups);
-    const vec3 x_index = vec3_madd(o, d, w.t);
+    const vec3 x_index = vec3_madd(entry, d, w.t);
     const float rho = grid_density(KERNEL_CONTEXT_ARG, x_index);
 #ifdef EMISSION
     if (rho > 0.0f) /* β ⊙ σa·Le/σ̄ at every tentative collision (above) */
@@ -224,7 +233,7 @@ static inline int tracking_delta(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, 
       }
       if (u < pa + ps) {
         TRACK_COUNT(real);
-        *t_out = w.t;
+        *t_out = t + w.t;
         return TRACK_SCATTERED;
       }
       continue;
@@ -249,7 +258,7 @@ static inline int tracking_delta(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, 
     if (x < wa + ws) {
       TRACK_COUNT(real);
       *beta = vec3_scale(vec3_mul(b, sig_s), c / (sigma_bar * ws));
-      *t_out = w.t;
+      *t_out = t + w.t;
       return TRACK_SCATTERED;
     }
     *beta = vec3_scale(vec3_mul(b, sig_n), c / (sigma_bar * wn));
@@ -272,12 +281,13 @@ static inline vec3 tracking_ratio(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t,
   const vec3 st = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
   /* A homogeneous medium has the closed form: Beer-Lambert, no variance. */
   if (GRID_IS_HOMOGENEOUS_CTX(ctx)) return vec3_exp_neg(vec3_scale(st, nv_fmax(0.0f, t_max - t)));
-  tracking_walk w = tracking_walk_begin(m, TRACKING_USE_MAJORANT_GRID(m), o, d, t, t_max);
+  const vec3 entry = tracking_entry(o, d, t);
+  tracking_walk w = tracking_walk_begin(m, TRACKING_USE_MAJORANT_GRID(m), entry, d, 0.0f, t_max - t);
   for (int step = 0; step < TRACKING_MAX_STEPS; ++step) {
     if (!tracking_walk_step(&w, GRID_MAJORANTS, sample_exponential(rng_uniform(rng), 1.0f), status)) return tr;
     const float inv_bar = 1.0f / w.bar;
     TRACK_COUNT(lookups);
-    const float rho = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(o, d, w.t));
+    const float rho = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(entry, d, w.t));
     const vec3 wt = vec3_sub(vec3_splat(1.0f), vec3_scale(st, rho * inv_bar)); /* σn/σ̄ per channel */
     const float w_min = nv_fmin(wt.x, nv_fmin(wt.y, wt.z));
     if (!(w_min >= 0.0f)) {
