@@ -14,6 +14,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <openvdb/openvdb.h>
+
+#include <filesystem>
+
 #include "cli/cli_fixture.h"
 #include "volume/grid.h"
 
@@ -88,6 +92,51 @@ TEST_F(InfoCli, DescribesAVolFile) {
             "    world box   [0, 0, 0] to [2, 1, 1]\n"
             "    values      0 to 3.5\n"
             "    memory      8 B, dense in narval 8 B\n");
+}
+
+// Every shipped real grid (../shared/data/volumes, or NARVAL_DATA_DIR) against what OpenVDB wrote
+// into the file when it saved it, read here without narval's code: the per-grid metadata
+// file_voxel_count, file_bbox_min and file_bbox_max, the grid's name, value type and class, and
+// the transform's voxel size.
+TEST_F(InfoCli, EveryShippedGridAgreesWithOpenVdbsOwnMetadata) {
+  const std::filesystem::path folder = std::filesystem::path(test::realDataPath("x")).parent_path();
+  std::vector<std::string> files;
+  if (std::filesystem::is_directory(folder))
+    for (const auto& e : std::filesystem::directory_iterator(folder))
+      if (e.path().extension() == ".vdb") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) GTEST_SKIP() << "real data absent: no .vdb in " << folder << " (set NARVAL_DATA_DIR)";
+  openvdb::initialize();
+  for (const std::string& path : files) {
+    SCOPED_TRACE(path);
+    const test::RunResult r = run("info '" + path + "' --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json grids = nlohmann::json::parse(r.out);
+    openvdb::io::File file(path);
+    file.open(false);  // no delayed loading: metadata only below
+    const openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();
+    file.close();
+    ASSERT_EQ(grids.size(), metas->size());
+    for (const openvdb::GridBase::Ptr& m : *metas) {
+      const openvdb::GridBase& meta = *m;
+      SCOPED_TRACE(meta.getName());
+      const auto named = std::find_if(grids.begin(), grids.end(),
+                                      [&](const nlohmann::json& g) { return g["name"] == meta.getName(); });
+      ASSERT_NE(named, grids.end()) << "narval info does not list it";
+      const nlohmann::json& g = *named;
+      EXPECT_EQ(g["type"], meta.valueType());
+      EXPECT_EQ(g["class"], openvdb::GridBase::gridClassToString(meta.getGridClass()));
+      const auto count = meta.getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT);
+      const auto lo = meta.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+      const auto hi = meta.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+      ASSERT_TRUE(count && lo && hi) << "the file does not carry OpenVDB's statistics metadata";
+      EXPECT_EQ(g["active_voxels"].get<int64_t>(), count->value());
+      EXPECT_EQ(g["index_min"], nlohmann::json({lo->value().x(), lo->value().y(), lo->value().z()}));
+      EXPECT_EQ(g["index_max"], nlohmann::json({hi->value().x(), hi->value().y(), hi->value().z()}));
+      const openvdb::Vec3d voxel = meta.transform().voxelSize();
+      for (int a = 0; a < 3; ++a) EXPECT_NEAR(g["voxel_size"][a].get<double>(), voxel[a], 1e-9 * voxel[a]);
+    }
+  }
 }
 
 TEST_F(InfoCli, UnreadableFilesAreOneLineAndExitTwo) {

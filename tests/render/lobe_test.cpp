@@ -86,13 +86,6 @@ double lengthInside(D3 a, D3 b, D3 lo, D3 hi) {
 
 double hg(double g, double mu) { return (1 - g * g) / (4 * M_PI * std::pow(1 + g * g - 2 * g * mu, 1.5)); }
 
-// ---------------------------------------------------------------------------------------------
-// Eq. 7 as DESIGN.md states it, evaluated independently in double precision for a homogeneous
-// axis-aligned box and point lights, where every transmittance is exactly exp(−σt·ℓ), ℓ the
-// length inside the box (the kernel's midpoint rule is exact for constant σ up to float
-// rounding). The pinned conventions: x0 = box entry (ρ ≡ 1 > 0), c = x0 + min(df/σ̄t, rest)·ω,
-// lobe frame (t, b, ω) with t the camera's right vector made perpendicular to ω and b = ω × t,
-// P_i = c + r·d_i, cos θ_i = dot(normalize(P_i − light), −d_i), albedo = σs/σt.
 // The lobe's frame about a view direction: the camera's right vector made perpendicular to it,
 // exactly as the normalisation of that projection (so Eq. 7's pixels are what they were); for a
 // direction along ±right, which has no such component, still an orthonormal right-handed frame.
@@ -120,8 +113,116 @@ TEST(RenderLobe, FrameIsOrthonormalEvenAlongTheRightVector) {
   EXPECT_EQ(t.z, expected.z);
 }
 
-TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
-  Scene scene = sceneFromJson(R"({
+// ---------------------------------------------------------------------------------------------
+// Eq. 7 as DESIGN.md states it, evaluated independently in double precision for a homogeneous
+// axis-aligned box and point lights, where every transmittance is exactly exp(−σt·ℓ), ℓ the
+// length inside the box (the kernel's midpoint rule is exact for constant σ up to float
+// rounding). The pinned conventions: x0 = box entry (ρ ≡ 1 > 0), c = x0 + min(df/σ̄t, rest)·ω,
+// lobe frame (t, b, ω) with t the camera's right vector made perpendicular to ω and b = ω × t,
+// P_i = c + r·d_i, cos θ_i = dot(normalize(P_i − light), −d_i), albedo = σs/σt.
+// The box's placement as the scene format states it (docs/scene-format.md: M = T·Rz·Ry·Rx·S on
+// the unit cube), built here from the angles: world → the box's frame, where it is [−½, ½]·scale.
+struct BoxFrame {
+  D3 centre, half, axes[3];  // axes: the rotated unit x, y, z
+  D3 local(D3 p) const {
+    const D3 q = sub(p, centre);
+    return {dot(q, axes[0]), dot(q, axes[1]), dot(q, axes[2])};
+  }
+  D3 localDir(D3 d) const { return {dot(d, axes[0]), dot(d, axes[1]), dot(d, axes[2])}; }
+};
+
+BoxFrame boxFrame(D3 centre, D3 scaleXyz, D3 degrees) {
+  const double ax = degrees[0] * M_PI / 180, ay = degrees[1] * M_PI / 180, az = degrees[2] * M_PI / 180;
+  auto rot = [&](D3 v) {  // Rz · Ry · Rx · v
+    v = {v[0], std::cos(ax) * v[1] - std::sin(ax) * v[2], std::sin(ax) * v[1] + std::cos(ax) * v[2]};
+    v = {std::cos(ay) * v[0] + std::sin(ay) * v[2], v[1], -std::sin(ay) * v[0] + std::cos(ay) * v[2]};
+    return D3{std::cos(az) * v[0] - std::sin(az) * v[1], std::sin(az) * v[0] + std::cos(az) * v[1], v[2]};
+  };
+  return {centre, scale(scaleXyz, 0.5), {rot({1, 0, 0}), rot({0, 1, 0}), rot({0, 0, 1})}};
+}
+
+// Eq. 7 evaluated independently (above) for the homogeneous box of `scene` (its third material,
+// point lights la and lb), placed by `box`, against the device's pixels and the host's.
+void expectEquation7(const Scene& sceneIn, const BoxFrame& box, int* hits) {
+  Scene scene = sceneIn;
+  scene.renderer.algorithm = Algorithm::Lobe;
+  const RenderResult r = renderLobe(scene);
+  ASSERT_EQ(r.stats.status, 0u);
+  const DeviceScene ds = buildDeviceScene(scene, nullptr);
+  const camera_params& cam = ds.params.camera;
+  const int W = scene.renderer.width, H = scene.renderer.height;
+  const Material& fog = scene.materials[2];
+  double sigS[3], sigA[3], sigT[3], meanSigT = 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    sigS[ch] = double(fog.scattering[ch]) * fog.density;
+    sigA[ch] = double(fog.absorption[ch]) * fog.density;
+    meanSigT += (sigT[ch] = sigS[ch] + sigA[ch]) / 3;
+  }
+  const D3 lo = scale(box.half, -1), hi = box.half;
+  // Lengths inside the box, measured in its frame (a rotation keeps lengths).
+  auto inside = [&](D3 a, D3 b) { return lengthInside(box.local(a), box.local(b), lo, hi); };
+  const double g = fog.g, radius = scene.renderer.lobe.lobeRadius, depthFactor = scene.renderer.lobe.depthFactor;
+  const D3 lightPos[2] = {d3(scene.primitives[0].transform.position), d3(scene.primitives[1].transform.position)};
+  const D3 lightI[2] = {d3(scene.materials[0].albedo), d3(scene.materials[1].albedo)};
+  const int n = scene.renderer.lobe.lobePoints;
+  const std::vector<nv_float4> dirs = lobeDirections(n, float(g), scene.renderer.seed);
+
+  const realtime_params params = realtimeParams(scene, ds);
+  const grid_view homogeneous{nullptr, 1, 1, 1};
+  for (int py = 0; py < H; ++py)
+    for (int px = 0; px < W; ++px) {
+      const D3 o = d3(cam.position);
+      const double sx = (2 * (px + 0.5) / W - 1) * cam.tan_half_vfov * cam.aspect;
+      const double sy = (1 - 2 * (py + 0.5) / H) * cam.tan_half_vfov;
+      const D3 w = normalized(add(d3(cam.forward), add(scale(d3(cam.right), sx), scale(d3(cam.up), sy))));
+      double ref[3] = {scene.background[0], scene.background[1], scene.background[2]};
+      double t0, t1;
+      if (slab(box.local(o), box.localDir(w), lo, hi, &t0, &t1) && t1 > 0) {
+        ++*hits;
+        t0 = std::max(t0, 0.0);  // a camera inside starts at its own position
+        const D3 x0 = add(o, scale(w, t0));
+        const D3 c = add(x0, scale(w, std::min(depthFactor / meanSigT, t1 - t0)));
+        const D3 right = d3(cam.right);
+        const D3 tx = normalized(sub(right, scale(w, dot(right, w)))), ty = cross(w, tx);
+        double trSum[3] = {0, 0, 0}, inSum[3] = {0, 0, 0};
+        for (const nv_float4& q : dirs) {
+          const D3 d = add(add(scale(tx, q.x), scale(ty, q.y)), scale(w, q.z));
+          const D3 P = add(c, scale(d, radius));
+          const double lView = inside(x0, P);
+          for (int ch = 0; ch < 3; ++ch) trSum[ch] += std::exp(-sigT[ch] * lView);
+          for (int k = 0; k < 2; ++k) {
+            const D3 v = sub(P, lightPos[k]);  // light → P_i
+            const double dist = std::sqrt(dot(v, v));
+            const double p = hg(g, dot(scale(v, 1 / dist), scale(d, -1)));
+            const double lShadow = inside(P, lightPos[k]);
+            for (int ch = 0; ch < 3; ++ch)
+              inSum[ch] += p * std::exp(-sigT[ch] * lShadow) * lightI[k][ch] / (dist * dist);
+          }
+        }
+        for (int ch = 0; ch < 3; ++ch)
+          ref[ch] = scene.background[ch] * trSum[ch] / n + sigS[ch] / sigT[ch] * inSum[ch] / n;
+      }
+      // The very header the device ran, compiled for the host (DESIGN.md: shared headers are
+      // tested on the host): same float algorithm, so agreement to float rounding.
+      uint status = 0;
+      const vec3 host =
+          lobe_pixel(narval::test::sceneContext(&ds.params, ds.lights.data(), &homogeneous, &status), &params,
+                     dirs.data(), nullptr, px, py);
+      EXPECT_EQ(status, 0u);
+      const float hostRgb[3] = {host.x, host.y, host.z};
+      for (int ch = 0; ch < 3; ++ch) {
+        const float dev = r.image.rgb[size_t(py * W + px) * 3 + size_t(ch)];
+        // Float rounding: 100-step sums of σt·Δ (~1e-6 relative each) inside exp of optical depths
+        // below ~10 and 16-term sums: well under 1e-4 relative.
+        EXPECT_NEAR(dev, ref[ch], 1e-4 * ref[ch] + 1e-7) << "pixel " << px << "," << py << " channel " << ch;
+        EXPECT_NEAR(hostRgb[ch], dev, 1e-5 * dev + 1e-7) << "pixel " << px << "," << py << " channel " << ch;
+      }
+    }
+}
+
+// The full estimator (depth factor, 16 lobe points of radius 0.8, two lights, chromatic σ), on an
+// axis-aligned box, the same box rotated, and with the camera inside the rotated box.
+const char* const kEquation7Scene = R"({
     "materials": [
       {"name": "a", "type": "emitter", "albedo": [10, 9, 8]},
       {"name": "b", "type": "emitter", "albedo": [4, 5, 6]},
@@ -140,75 +241,35 @@ TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
                  "lobe": {"depthFactor": 3, "lobePoints": 16, "lobeRadius": 0.8, "shadowSteps": 100,
                           "viewSteps": 100, "minTransmittance": 0}},
     "background": [0.2, 0.3, 0.4]
-  })");
-  scene.renderer.algorithm = Algorithm::Lobe;
-  const RenderResult r = renderLobe(scene);
-  ASSERT_EQ(r.stats.status, 0u);
-  const DeviceScene ds = buildDeviceScene(scene, nullptr);
-  const camera_params& cam = ds.params.camera;
-  const double sigS[3] = {0.6 * 1.5, 0.4 * 1.5, 0.3 * 1.5}, sigA[3] = {0.05 * 1.5, 0.1 * 1.5, 0.02 * 1.5};
-  double sigT[3], meanSigT = 0;
-  for (int ch = 0; ch < 3; ++ch) meanSigT += (sigT[ch] = sigS[ch] + sigA[ch]) / 3;
-  const D3 lo = {0.1 - 2, -0.2 - 1.5, 0.3 - 2.5}, hi = {0.1 + 2, -0.2 + 1.5, 0.3 + 2.5};
-  const double g = 0.5, radius = 0.8, depthFactor = 3, bg[3] = {0.2, 0.3, 0.4};
-  const D3 lightPos[2] = {{2.5, 3, -3}, {-3, -1, 4}};
-  const double lightI[2][3] = {{10, 9, 8}, {4, 5, 6}};
-  const std::vector<nv_float4> dirs = lobeDirections(16, float(g), 7);
+  })";
 
-  const realtime_params params = realtimeParams(scene, ds);
-  const grid_view homogeneous{nullptr, 1, 1, 1};
+TEST(RenderLobe, MatchesEquation7OnAHomogeneousBox) {
   int hits = 0;
-  for (int py = 0; py < 7; ++py)
-    for (int px = 0; px < 9; ++px) {
-      const D3 o = d3(cam.position);
-      const double sx = (2 * (px + 0.5) / 9 - 1) * cam.tan_half_vfov * cam.aspect;
-      const double sy = (1 - 2 * (py + 0.5) / 7) * cam.tan_half_vfov;
-      const D3 w = normalized(add(d3(cam.forward), add(scale(d3(cam.right), sx), scale(d3(cam.up), sy))));
-      double ref[3] = {bg[0], bg[1], bg[2]};
-      double t0, t1;
-      if (slab(o, w, lo, hi, &t0, &t1) && t1 > 0) {
-        ++hits;
-        t0 = std::max(t0, 0.0);
-        const D3 x0 = add(o, scale(w, t0));
-        const D3 c = add(x0, scale(w, std::min(depthFactor / meanSigT, t1 - t0)));
-        const D3 right = d3(cam.right);
-        const D3 tx = normalized(sub(right, scale(w, dot(right, w)))), ty = cross(w, tx);
-        double trSum[3] = {0, 0, 0}, inSum[3] = {0, 0, 0};
-        for (const nv_float4& q : dirs) {
-          const D3 d = add(add(scale(tx, q.x), scale(ty, q.y)), scale(w, q.z));
-          const D3 P = add(c, scale(d, radius));
-          const double lView = lengthInside(x0, P, lo, hi);
-          for (int ch = 0; ch < 3; ++ch) trSum[ch] += std::exp(-sigT[ch] * lView);
-          for (int k = 0; k < 2; ++k) {
-            const D3 v = sub(P, lightPos[k]);  // light → P_i
-            const double dist = std::sqrt(dot(v, v));
-            const double p = hg(g, dot(scale(v, 1 / dist), scale(d, -1)));
-            const double lShadow = lengthInside(P, lightPos[k], lo, hi);
-            for (int ch = 0; ch < 3; ++ch)
-              inSum[ch] += p * std::exp(-sigT[ch] * lShadow) * lightI[k][ch] / (dist * dist);
-          }
-        }
-        for (int ch = 0; ch < 3; ++ch)
-          ref[ch] = bg[ch] * trSum[ch] / 16 + sigS[ch] / sigT[ch] * inSum[ch] / 16;
-      }
-      // The very header the device ran, compiled for the host (DESIGN.md: shared headers are
-      // tested on the host): same float algorithm, so agreement to float rounding.
-      uint status = 0;
-      const vec3 host =
-          lobe_pixel(narval::test::sceneContext(&ds.params, ds.lights.data(), &homogeneous, &status), &params,
-                     dirs.data(), nullptr, px, py);
-      EXPECT_EQ(status, 0u);
-      const float hostRgb[3] = {host.x, host.y, host.z};
-      for (int ch = 0; ch < 3; ++ch) {
-        const float dev = r.image.rgb[size_t(py * 9 + px) * 3 + size_t(ch)];
-        // Float rounding: 100-step sums of σt·Δ (~1e-6 relative each) inside exp of optical depths
-        // below ~10 and 16-term sums: well under 1e-4 relative.
-        EXPECT_NEAR(dev, ref[ch], 1e-4 * ref[ch] + 1e-7) << "pixel " << px << "," << py << " channel " << ch;
-        EXPECT_NEAR(hostRgb[ch], dev, 1e-5 * dev + 1e-7) << "pixel " << px << "," << py << " channel " << ch;
-      }
-    }
+  expectEquation7(sceneFromJson(kEquation7Scene), boxFrame({0.1, -0.2, 0.3}, {4, 3, 5}, {0, 0, 0}), &hits);
   EXPECT_GT(hits, 20);  // most pixels see the medium; the rest check L = L_b
   EXPECT_LT(hits, 63);
+}
+
+TEST(RenderLobe, MatchesEquation7OnARotatedBoxAndFromInsideIt) {
+  Scene scene = sceneFromJson(kEquation7Scene);
+  const D3 degrees = {25, -40, 15};
+  for (int a = 0; a < 3; ++a) scene.primitives[2].transform.rotation[a] = float(degrees[a]);
+  int hits = 0;
+  {
+    SCOPED_TRACE("rotated box");
+    expectEquation7(scene, boxFrame({0.1, -0.2, 0.3}, {4, 3, 5}, degrees), &hits);
+  }
+  EXPECT_GT(hits, 20);
+  EXPECT_LT(hits, 63);
+  // The camera inside the rotated box: every pixel's ray starts in the medium (x0 = the camera).
+  scene.camera.position = {0.5f, 0.1f, -0.4f};
+  scene.camera.lookAt = {1.5f, 0.5f, 2.0f};
+  hits = 0;
+  {
+    SCOPED_TRACE("camera inside");
+    expectEquation7(scene, boxFrame({0.1, -0.2, 0.3}, {4, 3, 5}, degrees), &hits);
+  }
+  EXPECT_EQ(hits, 63);
 }
 
 // ---------------------------------------------------------------------------------------------
