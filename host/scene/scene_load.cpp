@@ -296,6 +296,10 @@ Material readMaterial(JsonContext& ctx, const json& value, const std::string& ke
     m.gridName = r.getString("grid", m.gridName);
     if (m.gridName.empty()) ctx.fail(r.keyOf("grid"), "must not be empty");
     m.gridSpace = readEnum(r, "gridSpace", kGridSpaces, m.gridSpace);
+    // A homogeneous medium (no "path") has no grid to name or place: say so rather than ignore it.
+    if (m.path.empty())
+      for (const char* k : {"grid", "gridSpace"})
+        if (r.has(k)) ctx.warn(r.keyOf(k), "ignored: the medium is homogeneous (no \"path\")");
     if (const json* e = r.find("emission")) m.emission = readEmission(ctx, *e, r.keyOf("emission"), !m.path.empty());
   }
   r.reportUnknown();

@@ -56,7 +56,12 @@ TEST_F(MajorantCli, StatsJsonReportsMajorantAndCounters) {
   RunResult r = run("render scene.json -o a.exr --stats-json a.json");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json a = nlohmann::json::parse(readFile(dir_ / "a.json"));
-  EXPECT_TRUE(a["majorant"] == "grid" || a["majorant"] == "global") << a["majorant"];
+  // The default device is the first GPU, else the first CPU (narval devices): auto picks for it.
+  const RunResult d = run("devices --json");
+  ASSERT_EQ(d.code, 0) << d.err;
+  bool gpu = false;
+  for (const nlohmann::json& dev : nlohmann::json::parse(d.out)) gpu = gpu || dev["type"] == "GPU";
+  EXPECT_EQ(a["majorant"], gpu ? "global" : "grid");
   EXPECT_EQ(a["majorant_cells"], nlohmann::json({12, 12, 12}));
   EXPECT_FALSE(a.contains("collisions_tentative"));
   r = run("render scene.json -o a.exr --majorant auto --stats-json a2.json");

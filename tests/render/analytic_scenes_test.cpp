@@ -30,6 +30,21 @@ TEST(RenderAnalytic, AbsorptionOnlyBoxMatchesBeerLambert) {
     const ChannelStats s = channelStats(r.image, ch);
     EXPECT_NEAR(s.mean / kAbsorptionBoxLe[ch], expected, 0.005 * expected) << "channel " << ch;
   }
+  // Per 4x4 tile as well (an image mean would let a shifted or mirrored image pass): 16 px × 2560
+  // Bernoulli samples, standard error sqrt(T(1−T)/40960) ≈ 0.0025; 4.5 of them per tile and
+  // channel, a false alarm about 1 in 3000 over the 48.
+  for (int ty = 0; ty < 4; ++ty)
+    for (int tx = 0; tx < 4; ++tx) {
+      double tile[3] = {0, 0, 0}, T = 0;
+      for (int y = ty * 4; y < ty * 4 + 4; ++y)
+        for (int x = tx * 4; x < tx * 4 + 4; ++x) {
+          T += absorptionBoxTransmittance(c, x, y) / 16.0;
+          for (int ch = 0; ch < 3; ++ch) tile[ch] += r.image.pixel(x, y)[ch] / kAbsorptionBoxLe[ch] / 16.0;
+        }
+      const double se = std::sqrt(T * (1 - T) / (16.0 * 2560.0));
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(tile[ch], T, 4.5 * se) << "tile " << tx << "," << ty << " channel " << ch;
+    }
   EXPECT_EQ(r.stats.status, 0u);
   EXPECT_EQ(r.stats.nanPixels, 0);
 }

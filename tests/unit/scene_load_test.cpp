@@ -199,7 +199,8 @@ TEST(SceneDefaults, ExtensionsAreRead) {
       "lobe": {"depthFactor": 0, "lobePoints": 5, "lobeRadius": 0.25, "shadowSteps": 9}})"));
   j["background"] = {0.05, 0.07, 0.1};
   const Scene s = parseScene(j.dump(), "s.json");
-  EXPECT_TRUE(s.warnings.empty());
+  // Read all the same; the medium has no "path", which the two grid keys are told about.
+  EXPECT_EQ(s.warnings.size(), 2u);
   EXPECT_EQ(s.materials[1].phase, PhaseFunction::HenyeyGreenstein);
   EXPECT_EQ(s.materials[1].g, -0.3f);
   EXPECT_EQ(s.materials[1].gridName, "smoke");
@@ -428,6 +429,17 @@ TEST(SceneErrors, NearMissKeysNameTheKeyTheyProbablyMeant) {
   j["materials"][1].erase("scattering");
   j["materials"][1]["Scattering"] = {1, 1, 1};
   EXPECT_EQ(errorOf(j), "s.json: materials[1].scattering: missing required key (is \"Scattering\" meant to be it?)");
+}
+
+// A grid named or placed on a medium without a grid file has nothing to act on.
+TEST(SceneWarnings, GridKeysOnAHomogeneousMedium) {
+  json j = minimalScene();
+  j["materials"][1]["grid"] = "smoke";
+  j["materials"][1]["gridSpace"] = "file";
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
+            (std::vector<std::string>{
+                "s.json: materials[1].grid: ignored: the medium is homogeneous (no \"path\")",
+                "s.json: materials[1].gridSpace: ignored: the medium is homogeneous (no \"path\")"}));
 }
 
 TEST(SceneWarnings, HenyeyGreensteinAtPlusMinusOneIsClamped) {
