@@ -93,6 +93,22 @@ void expectPathtraceMean(const RenderResult& r, const std::vector<double>& T, in
     const ChannelStats s = channelStats(r.image, ch);
     EXPECT_NEAR(s.mean, mean, 4.5 * se) << what << " channel " << ch << " (σ " << se << ")";
   }
+  // The same per 4x4 tile (an image mean lets a mirrored or shifted image pass), at 5σ per tile and
+  // channel: false alarm 6e-7 each, below 1e-4 over the at most 64 tiles × 3 channels here.
+  const int W = r.image.width, H = r.image.height;
+  for (int ty = 0; ty < H; ty += 4)
+    for (int tx = 0; tx < W; tx += 4) {
+      double tileT = 0, tileVar = 0, tile[3] = {0, 0, 0}, n = 0;
+      for (int y = ty; y < std::min(H, ty + 4); ++y)
+        for (int x = tx; x < std::min(W, tx + 4); ++x) {
+          const double t = T[size_t(y) * W + x];
+          tileT += t, tileVar += t * (1 - t) / spp, n += 1;
+          for (int ch = 0; ch < 3; ++ch) tile[ch] += pixel(r.image, x, y, ch);
+        }
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(tile[ch] / n, tileT / n, 5 * std::sqrt(tileVar) / n + 1e-9)
+            << what << " tile " << tx / 4 << "," << ty / 4 << " channel " << ch;
+    }
 }
 
 // Reference per pixel averaged over the pixel (the path tracer jitters inside it) by 4 × 4 rays.
