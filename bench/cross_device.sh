@@ -92,7 +92,7 @@ while IFS=$'\t' read -r -u 3 index type name; do
     --stats-json "$work/dev_$index.json" >/dev/null
   build/narval render "$scene" -o "$work/frames_$index.exr" "${common[@]}" --frames "$frames" \
     --stats-json "$work/frames_$index.json" >/dev/null
-  build/narval compare "$work/dev_$first.exr" "$out" --json >"$work/compare_$index.json"
+  build/narval compare "$work/dev_$first.exr" "$out" --json --tonemap none --exposure 0 >"$work/compare_$index.json"
   rows+=("$(python3 - "$index" "$type" "$name" "$work/dev_$index.json" "$work/frames_$index.json" \
     "$work/compare_$index.json" <<'PY'
 import json, sys

@@ -38,7 +38,7 @@ ref() {
   echo "$out"
 }
 delta() {  # REF TEST -> "mean ΔE76 | JND%"
-  "$narval" compare "$1" "$2" --json | python3 -c \
+  "$narval" compare "$1" "$2" --json --tonemap none --exposure 0 | python3 -c \
     "import json,sys; d=json.load(sys.stdin); print('%.2f | %.1f%%' % (d['mean_dE76'], d['jnd76_pct']))"
 }
 

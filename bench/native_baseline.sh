@@ -174,7 +174,7 @@ for c in "${cases[@]}"; do
         if [ "$v" = native ]; then nc+=" $(cpu "$tag-native")"; fi
       done
     done
-    "$narval" compare "$work/$tag-pocl.exr" "$work/$tag-native.exr" --json >"$work/$tag-de.json"
+    "$narval" compare "$work/$tag-pocl.exr" "$work/$tag-native.exr" --json --tonemap none --exposure 0 >"$work/$tag-de.json"
     size=$(json "$work/$tag-pocl.json" '"%dx%d" % (j["width"], j["height"]) + (", %d spp" % j["spp"] if j["algorithm"] == "pathtrace" else "")')
     others=""
     for v in "${variants[@]:1}"; do others+="$v:${times[$v]}|"; done

@@ -12,7 +12,7 @@
 # resolution. References are rendered once per scene and resolution listed in --ref-resolutions and
 # kept in DIR; later runs reuse them (`narval render --resume`: a finished file renders nothing, a
 # file from other settings is rendered again). Then a second table: lobe/raymarch (cache on) and
-# cache off/on per kernel. ΔE: `narval compare` with its default display transform (none: linear
+# cache off/on per kernel. ΔE: `narval compare --tonemap none --exposure 0` (linear
 # values clipped to [0, 1]), as in the rest of bench/RESULTS.md.
 # Defaults: scenes listing_4_1, disney_cloud, cloud, smoke; 320x240 and 1280x720; 7 frames;
 # references at 320x240 only, 256 spp; DIR build/realtime_frames (every image and stats file of
@@ -155,8 +155,9 @@ reference() {
     "${device[@]}" >/dev/null
 }
 
-# compare REF TEST JSON: narval compare's statistics (default display transform) into JSON.
-compare() { "$narval" compare "$1" "$2" --json >"$3"; }
+# compare REF TEST JSON: narval compare's statistics into JSON, linear (no tone mapping, exposure 0:
+# the transform the recorded results used; compare's default is now the scene's, from the EXRs).
+compare() { "$narval" compare "$1" "$2" --json --tonemap none --exposure 0 >"$3"; }
 
 for scene in "${scene_list[@]}"; do
   name=$(basename "$scene" .json)
