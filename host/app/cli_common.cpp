@@ -82,10 +82,6 @@ void addThreadsOption(CLI::App* sub) {
       ->check(between(1, 4096));
 }
 
-void addQuietOption(CLI::App* sub, bool* quiet) {
-  sub->add_flag("-q,--quiet", *quiet, "Print only errors and warnings (no progress bar, no report lines)");
-}
-
 void checkOutputWritable(const std::string& path, const std::string& option) {
   namespace fs = std::filesystem;
   if (path.empty()) return;

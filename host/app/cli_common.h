@@ -32,9 +32,6 @@ CLI::Validator greaterThanZero();  // any finite number > 0
 // any device is opened); other OpenCL drivers ignore it.
 void addThreadsOption(CLI::App* sub);
 
-// --quiet: only errors and warnings on stderr; no progress bar and no report lines on stdout.
-void addQuietOption(CLI::App* sub, bool* quiet);
-
 // Before any work: makes `path`'s folder (as the writers would) and proves a file can be created
 // there (a temporary, removed again), so a render never runs only to fail at its last step.
 // InputError "OPTION: cannot write PATH: REASON" (exit 2) otherwise; an existing file at `path` is

@@ -338,7 +338,7 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("--exposure", a->exposure, "Exposure in stops of the PNG (overrides renderer.exposure)");
   sub->add_option("--tonemap", a->tonemap, "Tone mapping of the PNG: none | reinhard | aces (overrides renderer.toneMapping)")
       ->check(CLI::IsMember({"none", "reinhard", "aces"}));
-  addQuietOption(sub, &a->quiet);
+  sub->add_flag("-q,--quiet", a->quiet, "Print only errors and warnings (no progress bar, no report lines)");
   addThreadsOption(sub);
   CLI::Option* frames = sub->get_option("--frames");
   sub->add_flag("--resume", a->resume,
