@@ -5,10 +5,10 @@
 // without another library.
 //
 // What each algorithm runs per pixel, as the device does (kernels/*.cl):
-// - pathtrace: pathtrace_sample for samples 0..spp-1 in index order into a Kahan sum per channel
-//   (accum.h), image = sum / spp (imageFromRgba, the device driver's own read-back). The device
-//   splits the samples into launches, but adds them in index order to the same compensated state,
-//   so the sums are the same function of the per-sample values.
+// - pathtrace: pathtrace_sample for samples 0..spp-1 into the exact fixed-point sum (accum.h),
+//   image = its mean as the device driver reads it back (accumulatorImage). The device splits the
+//   samples into launches, but integer sums do not depend on the split, so the sums are the same
+//   function of the per-sample values.
 // - raymarch / lobe: raymarch_pixel / lobe_pixel, one deterministic value per pixel.
 // Same seed, same per-sample random numbers (Philox keyed by pixel and sample: rng.h). The only
 // arithmetic differences from PoCL are its libm (exp, log, sin, cos, pow) against glibc's.
@@ -52,6 +52,7 @@ static inline float native_fmaxf(float a, float b) { return (a > b || b != b) ? 
 #endif
 
 #include "image/image.h"
+#include "render/accumulator.h"
 #include "render/light_cache.h"
 #include "render/lobe_directions.h"
 #include "render/realtime_renderer.h"
@@ -138,7 +139,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
   const nv_float4* dirs = o.lobeDirections.data();
   const float* cache = o.lightCache.data();
 
-  // RGBA as the kernels write it: pathtrace the Kahan sums (A = 0), real-time the value.
+  // RGBA: the pixel's value (pathtrace: the mean of its samples), A = 0.
   std::vector<float> rgba(size_t(W) * size_t(H) * 4, 0.0f);
   std::atomic<int> nextRow{0};
   std::atomic<uint32_t> statusAll{0};
@@ -150,15 +151,14 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
       for (int x = 0; x < W; ++x) {
         vec3 L = vec3_splat(0.0f);
         switch (alg) {
-          case Algorithm::Pathtrace: {
-            float ax = 0.0f, ay = 0.0f, az = 0.0f, cx = 0.0f, cy = 0.0f, cz = 0.0f;
-            for (int s = 0; s < spp; ++s) {
-              const vec3 v = pathtrace_sample(&ctx, x, y, uint(s));
-              accum_kahan_add(&ax, &cx, v.x);
-              accum_kahan_add(&ay, &cy, v.y);
-              accum_kahan_add(&az, &cz, v.z);
-            }
-            L = vec3_make(ax, ay, az);
+          case Algorithm::Pathtrace: {  // the kernel's exact sum (accum.h), its mean as the host takes it
+            AccumulatorState sum;
+            sum.samples = spp;
+            sum.words.assign(ACCUM_WORDS, 0);
+            for (int s = 0; s < spp; ++s) accum_add_sample(sum.words.data(), pathtrace_sample(&ctx, x, y, uint(s)));
+            long long rejected = 0;
+            const ImageRGB mean = accumulatorImage(sum, 1, 1, &rejected);
+            L = vec3_make(mean.rgb[0], mean.rgb[1], mean.rgb[2]);
             break;
           }
           case Algorithm::Raymarch:
@@ -183,7 +183,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
   for (std::thread& t : pool) t.join();
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.status = statusAll.load();
-  r.image = imageFromRgba(rgba, W, H, alg == Algorithm::Pathtrace ? float(spp) : 1.0f, &r.nanPixels);
+  r.image = imageFromRgba(rgba, W, H, 1.0f, &r.nanPixels);
   return r;
 }
 

@@ -19,6 +19,16 @@ std::pair<int, int> parseSize(const std::string& text, const std::string& what) 
   return {std::stoi(m[1]), std::stoi(m[2])};
 }
 
+std::pair<int, int> parseSampleRange(const std::string& text, const std::string& what) {
+  std::smatch m;
+  static const std::regex re(R"(^(\d{1,10}):(\d{1,10})$)");
+  if (std::regex_match(text, m, re)) {
+    const long long a = std::stoll(m[1]), b = std::stoll(m[2]);
+    if (a < b && b <= 0x7fffffffLL) return {int(a), int(b)};
+  }
+  throw inputError(what, "", "expected A:B, the sample indices [A, B) with 0 <= A < B <= 2147483647, got '" + text + "'");
+}
+
 std::string resolutionOverride(const std::string& text) {
   const auto [w, h] = parseSize(text, "--resolution");
   return "renderer.resolution=[" + std::to_string(w) + "," + std::to_string(h) + "]";

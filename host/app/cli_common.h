@@ -18,6 +18,10 @@ namespace narval {
 // "WxH" -> {W, H} (positive); `what` names the option in the InputError.
 std::pair<int, int> parseSize(const std::string& text, const std::string& what);
 
+// "A:B" -> {A, B}: the sample indices [A, B) of --samples, 0 <= A < B < 2^31; `what` names the
+// option in the InputError.
+std::pair<int, int> parseSampleRange(const std::string& text, const std::string& what);
+
 // --resolution WxH as the scene override "renderer.resolution=[W,H]" (parseSize's errors name the flag).
 std::string resolutionOverride(const std::string& text);
 

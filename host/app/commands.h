@@ -20,5 +20,6 @@ Command addCompareCommand(CLI::App& app);
 Command addSweepCommand(CLI::App& app);
 Command addViewCommand(CLI::App& app);
 Command addInfoCommand(CLI::App& app);
+Command addMergeCommand(CLI::App& app);
 
 }  // namespace narval

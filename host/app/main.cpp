@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
   const std::vector<narval::Command> commands = {narval::addRenderCommand(app), narval::addDevicesCommand(app),
                                                  narval::addMakeCloudCommand(app), narval::addCompareCommand(app),
                                                  narval::addSweepCommand(app),
-                                                 narval::addViewCommand(app), narval::addInfoCommand(app)};
+                                                 narval::addViewCommand(app), narval::addInfoCommand(app),
+                                                 narval::addMergeCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

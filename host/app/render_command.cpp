@@ -28,7 +28,7 @@ namespace narval {
 namespace {
 
 struct RenderArgs {
-  std::string scene, out, algorithm, resolution, device, statsJson, localSize = "8x8";
+  std::string scene, out, algorithm, resolution, device, statsJson, localSize = "8x8", samples;
   int spp = -1, bounces = -1, frames = 0, samplesPerPass = 0, majorantResolution = 0;
   bool resume = false, counters = false, quiet = false;
   std::optional<double> exposure;
@@ -43,6 +43,10 @@ struct RenderArgs {
 std::vector<std::string> overridesFrom(const RenderArgs& a) {
   std::vector<std::string> o = a.sets;
   if (a.spp >= 0) o.push_back("renderer.spp=" + std::to_string(a.spp));
+  if (!a.samples.empty()) {  // --samples A:B renders B - A samples, from index A on
+    const auto [begin, end] = parseSampleRange(a.samples, "--samples");
+    o.push_back("renderer.spp=" + std::to_string(end - begin));
+  }
   if (a.bounces >= 0) o.push_back("renderer.bounces=" + std::to_string(a.bounces));
   if (a.seed >= 0) o.push_back("renderer.seed=" + std::to_string(a.seed));
   if (!a.algorithm.empty()) o.push_back("renderer.algorithm=\"" + a.algorithm + "\"");
@@ -62,6 +66,7 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"width", s.width},
           {"height", s.height},
           {"spp", s.spp},
+          {"sample_begin", s.sampleBegin},
           {"spp_requested", s.sppRequested},
           {"resumed_from_spp", s.resumedFromSpp},
           {"interrupted", s.interrupted},
@@ -134,6 +139,9 @@ int runRender(const RenderArgs& a) {
   // multiple-scattering cache traces paths, and it takes the scene's bounces.
   if (realtime && a.spp >= 0)
     throw inputError("--spp", "", "does not apply to " + algorithm + ", which renders frames (use --frames)");
+  if (realtime && !a.samples.empty())
+    throw inputError("--samples", "", "does not apply to " + algorithm + ", which renders frames (use --frames)");
+  const int sampleBegin = a.samples.empty() ? 0 : parseSampleRange(a.samples, "--samples").first;
   const bool cachePaths = scene.renderer.algorithm == Algorithm::Raymarch &&
                           scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache;
   if (realtime && a.bounces >= 0 && !cachePaths)
@@ -158,7 +166,7 @@ int runRender(const RenderArgs& a) {
   if (a.resume) {
     if (realtime) throw inputError("--resume", "", "only path-traced renders resume; the algorithm is " + algorithm);
     if (fs::exists(out)) {
-      resumeState = readAccumulator(out.string(), scene);
+      resumeState = readAccumulator(out.string(), scene, sampleBegin);
       resuming = true;
       resumeMajorant(out.string(), a, &majorant, &majorantResolution);
       if (resumeState.samples == scene.renderer.spp) {
@@ -188,6 +196,7 @@ int runRender(const RenderArgs& a) {
   options.localSizeX = lx;
   options.localSizeY = ly;
   options.samplesPerPass = a.samplesPerPass;
+  options.sampleBegin = sampleBegin;
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
   options.cancel = &interrupt.flag();
   if (resuming) options.resumeFrom = &resumeState;
@@ -221,7 +230,7 @@ int runRender(const RenderArgs& a) {
       show.last = std::chrono::steady_clock::now();
     }
     if (save.due()) {
-      writeRenderExr(out.string(), partial, scene);
+      writeRenderExr(out.string(), partial, renderIdentity(scene));
       save.last = std::chrono::steady_clock::now();
     }
   };
@@ -241,7 +250,7 @@ int runRender(const RenderArgs& a) {
 
   // The EXR, the PNG and the stats land together or not at all (staged_files.h).
   StagedFiles staged;
-  writeRenderExr(staged.stage(out.string()), r, scene);
+  writeRenderExr(staged.stage(out.string()), r, renderIdentity(scene));
   writePng(staged.stage(png.string()), r.image, scene.renderer.exposure, scene.renderer.toneMapping);
   if (!a.statsJson.empty()) {
     nlohmann::json j = statsJson(s, scene);
@@ -282,7 +291,10 @@ int runRender(const RenderArgs& a) {
   if (realtime)
     report << s.frames.count << " frame(s), " << s.frames.medianKernelMs << " ms per frame";
   else
-    report << s.spp << " spp, " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6
+    report << (a.samples.empty() ? std::to_string(s.spp) + " spp"
+                                 : "samples [" + std::to_string(s.sampleBegin) + ", " +
+                                       std::to_string(s.sampleBegin + s.spp) + ")")
+           << ", " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6
               << " Msamples/s";
   report << " on " << s.device << ")\n";
   return 0;
@@ -297,6 +309,11 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("-o,--output", a->out, "Output .exr (the .png goes beside it); default: <scene name>.exr");
   sub->add_option("--algorithm", a->algorithm, "pathtrace | raymarch | lobe");
   sub->add_option("--spp", a->spp, "pathtrace: samples per pixel")->check(atLeast(1));
+  CLI::Option* spp = sub->get_option("--spp");
+  sub->add_option("--samples", a->samples,
+                  "pathtrace: render only the sample indices [A, B) of every pixel (A:B), a part for `narval "
+                  "merge`; the EXR records the range")
+      ->excludes(spp);
   sub->add_option("--bounces", a->bounces,
                   "pathtrace and the ray marcher's multiple-scattering cache: real scattering events per path")
       ->check(atLeast(0));
@@ -341,6 +358,7 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_flag("-q,--quiet", a->quiet, "Print only errors and warnings (no progress bar, no report lines)");
   addThreadsOption(sub);
   CLI::Option* frames = sub->get_option("--frames");
+  sub->get_option("--samples")->excludes(frames);
   sub->add_flag("--resume", a->resume,
                 "pathtrace: continue the render already at the output path (interrupted, or with fewer spp) "
                 "to the requested spp; the pixels equal those of one uninterrupted render")

@@ -113,7 +113,7 @@ int runSweepCommand(const SweepArgs& a) {
   auto onRow = [&](const SweepRow& row) {
     const RenderStats& st = row.stats;
     const fs::path exr = dir / sweepFileName(parameter, row.value);
-    writeExr(exr.string(), row.image, renderAttributes(st, scene));  // the row's spp and bounces from its stats
+    writeExr(exr.string(), row.image, renderAttributes(st, renderIdentity(scene)));  // the row's spp and bounces from its stats
     for (const std::string& w : statusWarnings(st.status))
       std::cerr << "narval: warning: " << exr.string() << ": " << w << "\n";
     std::printf("%-14s %10.3f s", sweepLabel(parameter, row.value).c_str(), row.seconds);

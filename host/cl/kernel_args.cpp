@@ -22,7 +22,7 @@ std::vector<std::string> sceneArgsAnd(std::vector<std::string> more) {
 const std::map<std::string, std::vector<std::string>>& lists() {
   static const std::map<std::string, std::vector<std::string>> all = {
       // counter_buf exists only in the -DCOUNTERS build, as its last argument.
-      {"pathtrace", sceneArgsAnd({"accum_sum", "accum_comp", "sample_begin", "sample_count", "status_word",
+      {"pathtrace", sceneArgsAnd({"accum", "sample_begin", "sample_count", "status_word",
                                   "counter_buf"})},
       {"raymarch", sceneArgsAnd({"params", "lobe_directions", "light_cache", "ms_cache", "out", "status_word"})},
       {"lobe", sceneArgsAnd({"params", "lobe_directions", "light_cache", "ms_cache", "out", "status_word"})},

@@ -94,14 +94,14 @@ std::unique_ptr<Imf::InputFile> openExr(const std::string& path) {
 }  // namespace
 
 void writeExr(const std::string& path, const ImageRGB& image, const std::vector<ExrAttribute>& attributes,
-              const std::vector<ExrChannel>& extra) {
+              const std::vector<ExrUintChannel>& extra) {
   if (image.width <= 0 || image.height <= 0)
     throw std::runtime_error(writeErrorMessage(path, "empty image (" + std::to_string(image.width) + "x" +
                                                          std::to_string(image.height) + ")"));
   if (image.rgb.size() != size_t(image.width) * size_t(image.height) * 3)
     throw std::runtime_error(writeErrorMessage(path, "pixel buffer size does not match the image size"));
   const size_t pixels = size_t(image.width) * size_t(image.height);
-  for (const ExrChannel& c : extra)
+  for (const ExrUintChannel& c : extra)
     if (c.values.size() != pixels)
       throw std::runtime_error(writeErrorMessage(path, "channel " + c.name + " does not match the image size"));
 
@@ -110,7 +110,7 @@ void writeExr(const std::string& path, const ImageRGB& image, const std::vector<
   header.channels().insert("R", Imf::Channel(Imf::FLOAT));
   header.channels().insert("G", Imf::Channel(Imf::FLOAT));
   header.channels().insert("B", Imf::Channel(Imf::FLOAT));
-  for (const ExrChannel& c : extra) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+  for (const ExrUintChannel& c : extra) header.channels().insert(c.name, Imf::Channel(Imf::UINT));
   for (const ExrAttribute& a : attributes) {
     try {
       std::visit(
@@ -139,9 +139,9 @@ void writeExr(const std::string& path, const ImageRGB& image, const std::vector<
     frame.insert("R", Imf::Slice(Imf::FLOAT, base + 0 * sizeof(float), xStride, yStride));
     frame.insert("G", Imf::Slice(Imf::FLOAT, base + 1 * sizeof(float), xStride, yStride));
     frame.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xStride, yStride));
-    for (const ExrChannel& c : extra)
-      frame.insert(c.name, Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(c.values.data())),
-                                      sizeof(float), sizeof(float) * size_t(image.width)));
+    for (const ExrUintChannel& c : extra)
+      frame.insert(c.name, Imf::Slice(Imf::UINT, const_cast<char*>(reinterpret_cast<const char*>(c.values.data())),
+                                      sizeof(uint32_t), sizeof(uint32_t) * size_t(image.width)));
     file.setFrameBuffer(frame);
     file.writePixels(image.height);
   } catch (const std::exception& e) {
@@ -153,13 +153,19 @@ void writeExr(const std::string& path, const ImageRGB& image, const std::vector<
 
 namespace {
 
-// Reads the channels `names` (each must exist) as FLOAT into `out`, interleaved (names.size() floats
-// per pixel, in that order); *width and *height are the data window's size.
+// Reads the channels `names` (each must exist; with UINT, each must be stored as UINT) into `out`,
+// interleaved (names.size() values per pixel, in that order); *width and *height are the data
+// window's size. T is float (FLOAT, other types converted) or uint32_t (UINT, as stored).
+template <typename T>
 void readChannels(const std::string& path, Imf::InputFile& file, const std::vector<std::string>& names,
-                  std::vector<float>& out, int* width, int* height) {
+                  std::vector<T>& out, int* width, int* height) {
+  constexpr Imf::PixelType type = std::is_same_v<T, float> ? Imf::FLOAT : Imf::UINT;
   const Imf::Header& header = file.header();
   for (const std::string& name : names) {
-    if (!header.channels().findChannel(name)) {
+    const Imf::Channel* channel = header.channels().findChannel(name);
+    if (channel && type == Imf::UINT && channel->type != Imf::UINT)
+      throw inputError(path, name, "not a UINT channel");
+    if (!channel) {
       std::string found;
       for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
         found += (found.empty() ? "" : ", ") + std::string(it.name());
@@ -175,14 +181,14 @@ void readChannels(const std::string& path, Imf::InputFile& file, const std::vect
   *width = int(w);
   *height = int(h);
   const size_t stride = names.size();
-  out.assign(size_t(w * h) * stride, 0.0f);
-  const size_t xStride = stride * sizeof(float);
+  out.assign(size_t(w * h) * stride, T(0));
+  const size_t xStride = stride * sizeof(T);
   const size_t yStride = xStride * size_t(w);
   char* base = reinterpret_cast<char*>(out.data());
   Imf::FrameBuffer frame;
   // Slice::Make offsets the base pointer by the data window origin without overflow.
   for (size_t i = 0; i < names.size(); ++i)
-    frame.insert(names[i], Imf::Slice::Make(Imf::FLOAT, base + i * sizeof(float), window, xStride, yStride));
+    frame.insert(names[i], Imf::Slice::Make(type, base + i * sizeof(T), window, xStride, yStride));
   try {
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);
@@ -200,19 +206,31 @@ ImageRGB readExr(const std::string& path) {
   return image;
 }
 
-std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names) {
+namespace {
+// The named channels of `path`, one Channel (ExrChannel or ExrUintChannel) each.
+template <typename Channel>
+std::vector<Channel> readNamedChannels(const std::string& path, const std::vector<std::string>& names) {
   auto file = openExr(path);
-  std::vector<float> interleaved;
+  std::vector<typename decltype(Channel::values)::value_type> interleaved;
   int width = 0, height = 0;
   readChannels(path, *file, names, interleaved, &width, &height);
   const size_t pixels = size_t(width) * size_t(height), n = names.size();
-  std::vector<ExrChannel> channels(n);
+  std::vector<Channel> channels(n);
   for (size_t c = 0; c < n; ++c) {
     channels[c].name = names[c];
     channels[c].values.resize(pixels);
     for (size_t i = 0; i < pixels; ++i) channels[c].values[i] = interleaved[i * n + c];
   }
   return channels;
+}
+}  // namespace
+
+std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names) {
+  return readNamedChannels<ExrChannel>(path, names);
+}
+
+std::vector<ExrUintChannel> readExrUintChannels(const std::string& path, const std::vector<std::string>& names) {
+  return readNamedChannels<ExrUintChannel>(path, names);
 }
 
 std::map<std::string, std::string> readExrAttributes(const std::string& path) {

@@ -19,10 +19,15 @@ struct ImageRGB {
   const float* pixel(int x, int y) const { return &rgb[(size_t(y) * width + x) * 3]; }
 };
 
-// A named 32-bit float channel of width*height values, row 0 at the top (e.g. "accum_sum.R").
+// A named channel of width*height values, row 0 at the top, as 32-bit float or as 32-bit unsigned
+// int (OpenEXR's UINT: the path tracer's exact accumulator words, e.g. "accum.R.w0").
 struct ExrChannel {
   std::string name;
   std::vector<float> values;
+};
+struct ExrUintChannel {
+  std::string name;
+  std::vector<uint32_t> values;
 };
 
 // A header attribute, stored with the OpenEXR type of its value: string, int, float, double or
@@ -33,12 +38,12 @@ struct ExrAttribute {
   Value value;
 };
 
-// 32-bit float linear RGB EXR with `attributes` in the header; `extra` channels are stored beside
-// R, G and B (viewers show them as layers).
+// 32-bit float linear RGB EXR with `attributes` in the header; `extra` UINT channels are stored
+// beside R, G and B (viewers show them as layers).
 // Written to a temporary file beside `path` and renamed, so a failure never leaves a broken file
 // and never touches an existing `path`; it throws std::runtime_error "PATH: cannot write: REASON".
 void writeExr(const std::string& path, const ImageRGB& image, const std::vector<ExrAttribute>& attributes = {},
-              const std::vector<ExrChannel>& extra = {});
+              const std::vector<ExrUintChannel>& extra = {});
 // Reads R, G and B as 32-bit float (half or uint channels are converted) from any data window;
 // the result is the data window's size. A missing, unreadable or corrupt file, or a missing R, G or
 // B channel, throws InputError "PATH: what".
@@ -50,6 +55,9 @@ std::map<std::string, std::string> readExrAttributes(const std::string& path);
 // The named channels as 32-bit float, width*height values each in the data window's size; a
 // missing channel throws InputError "PATH: no NAME channel (channels: ...)", like readExr.
 std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names);
+// The named channels as stored, bit for bit: each must be a UINT channel, else InputError "PATH: NAME:
+// not a UINT channel"; a missing one throws like readExrChannels.
+std::vector<ExrUintChannel> readExrUintChannels(const std::string& path, const std::vector<std::string>& names);
 
 // 8-bit RGB pictures (display images, figures); row 0 at the top.
 struct ImageRGB8 {

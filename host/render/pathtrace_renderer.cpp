@@ -27,13 +27,13 @@ int pathtraceSamplesPerPass(int width, int height, int spp) {
 
 PathtraceRenderer::PathtraceRenderer(ClRuntime& rt, const Scene& scene, SceneGrids grid,
                                      const RenderOptions& options)
-    : rt_(rt), view_(scene), options_(options), dev_(rt, scene, grid) {
+    : rt_(rt), view_(scene), options_(options), dev_(rt, scene, grid), begin_(options.sampleBegin) {
   checkMajorantOptions(options);
   const int W = scene.renderer.width, H = scene.renderer.height;
   const AccumulatorState* resume = options.resumeFrom;
   const size_t pixels = size_t(W) * size_t(H);
-  if (resume && (resume->sum.size() != pixels * 4 || resume->comp.size() != pixels * 4 ||
-                 resume->samples > scene.renderer.spp))
+  if (resume && (resume->words.size() != pixels * kAccumulatorWords || resume->samples > scene.renderer.spp ||
+                 resume->begin != options.sampleBegin))
     throw std::invalid_argument("renderPathtrace: the state to resume from does not fit this render");
   warnings_ = dev_.scene.warnings;
   stats_ = initialStats("pathtrace", rt, scene);
@@ -53,25 +53,25 @@ PathtraceRenderer::PathtraceRenderer(ClRuntime& rt, const Scene& scene, SceneGri
   dev_.bind(kernel_);
   allocateAccumulator();
   if (resume) {
-    const size_t accumBytes = pixels * 4 * sizeof(float);
-    rt.queue.enqueueWriteBuffer(sumBuf_, CL_FALSE, 0, accumBytes, resume->sum.data());
-    rt.queue.enqueueWriteBuffer(compBuf_, CL_FALSE, 0, accumBytes, resume->comp.data());
+    rt.queue.enqueueWriteBuffer(accumBuf_, CL_FALSE, 0, accumulatorBytes(), resume->words.data());
     rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(resume->status), 0, sizeof(cl_uint));
     first_ = done_ = resume->samples;
   }
   rt.queue.finish();
 }
 
+size_t PathtraceRenderer::accumulatorBytes() const {
+  return size_t(view_.renderer.width) * size_t(view_.renderer.height) * kAccumulatorWords * sizeof(cl_ulong);
+}
+
 void PathtraceRenderer::allocateAccumulator() {
   const int W = view_.renderer.width, H = view_.renderer.height;
-  const size_t pixels = size_t(W) * size_t(H), accumBytes = pixels * 4 * sizeof(float);
+  const size_t pixels = size_t(W) * size_t(H);
   const AllocationSite site{view_.sourcePath, "renderer.resolution",
-                            "an accumulator of " + std::to_string(W) + "x" + std::to_string(H) + " RGBA floats"};
-  if (sumBuf_() == nullptr || sumBuf_.getInfo<CL_MEM_SIZE>() != accumBytes) {
-    sumBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, accumBytes, site);
-    compBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, accumBytes, site);
-    kernel_.set("accum_sum", sumBuf_);
-    kernel_.set("accum_comp", compBuf_);
+                            "an accumulator of " + std::to_string(W) + "x" + std::to_string(H) + " pixels"};
+  if (accumBuf_() == nullptr || accumBuf_.getInfo<CL_MEM_SIZE>() != accumulatorBytes()) {
+    accumBuf_ = allocateBuffer(rt_, CL_MEM_READ_WRITE, accumulatorBytes(), site);
+    kernel_.set("accum", accumBuf_);
     kernel_.set("status_word", statusBuf_);
     // -DCOUNTERS: three ulongs per pixel, each work-item adding to its own (pathtrace.cl).
     if (options_.counters) {
@@ -87,8 +87,7 @@ void PathtraceRenderer::allocateAccumulator() {
 
 void PathtraceRenderer::reset() {
   const size_t pixels = size_t(view_.renderer.width) * size_t(view_.renderer.height);
-  rt_.queue.enqueueFillBuffer(sumBuf_, 0.0f, 0, pixels * 4 * sizeof(float));
-  rt_.queue.enqueueFillBuffer(compBuf_, 0.0f, 0, pixels * 4 * sizeof(float));
+  rt_.queue.enqueueFillBuffer(accumBuf_, cl_ulong(0), 0, accumulatorBytes());
   rt_.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
   if (options_.counters) rt_.queue.enqueueFillBuffer(counterBuf_, cl_ulong(0), 0, pixels * 3 * sizeof(cl_ulong));
   first_ = done_ = 0;
@@ -110,9 +109,9 @@ void PathtraceRenderer::setView(const Scene& view) {
 double PathtraceRenderer::addSamples(int count) {
   const int W = view_.renderer.width, H = view_.renderer.height;
   const size_t pixels = size_t(W) * size_t(H);
-  const size_t deviceBytes = deviceSceneBytes(dev_.scene) + 2 * pixels * 4 * sizeof(float) +
+  const size_t deviceBytes = deviceSceneBytes(dev_.scene) + accumulatorBytes() +
                              (options_.counters ? pixels * 3 * sizeof(cl_ulong) : 0);
-  kernel_.set("sample_begin", cl_uint(done_));
+  kernel_.set("sample_begin", cl_uint(begin_ + done_));
   kernel_.set("sample_count", cl_uint(count));
   const cl::Event ev = launchAndWait(rt_, kernel_.get(), paddedGlobalRange(W, H, options_), localRange(options_),
                                      "pathtrace", deviceBytes);
@@ -125,20 +124,21 @@ double PathtraceRenderer::addSamples(int count) {
 
 void PathtraceRenderer::readBack(RenderResult& into) {
   const int W = view_.renderer.width, H = view_.renderer.height;
-  const size_t pixels = size_t(W) * size_t(H), accumBytes = pixels * 4 * sizeof(float);
+  const size_t pixels = size_t(W) * size_t(H);
   AccumulatorState& acc = into.accumulator;
+  acc.begin = begin_;
   acc.samples = done_;
-  acc.sum.resize(pixels * 4);
-  acc.comp.resize(pixels * 4);
-  rt_.queue.enqueueReadBuffer(sumBuf_, CL_TRUE, 0, accumBytes, acc.sum.data());
-  rt_.queue.enqueueReadBuffer(compBuf_, CL_TRUE, 0, accumBytes, acc.comp.data());
+  acc.words.resize(pixels * kAccumulatorWords);
+  rt_.queue.enqueueReadBuffer(accumBuf_, CL_TRUE, 0, accumulatorBytes(), acc.words.data());
   rt_.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof(cl_uint), &into.stats.status);
   acc.status = into.stats.status;
   into.stats.spp = done_;
+  into.stats.sampleBegin = begin_;
   into.stats.sppRequested = view_.renderer.spp;
   into.stats.resumedFromSpp = first_;
   into.stats.interrupted = done_ < view_.renderer.spp;
-  if (done_ > 0) into.image = imageFromRgba(acc.sum, W, H, float(done_), &into.stats.nanPixels);
+  into.stats.nanPixels = 0;
+  if (done_ > 0) into.image = accumulatorImage(acc, W, H, &into.stats.nanPixels);
   if (options_.counters) {
     std::vector<cl_ulong> counts(pixels * 3);
     rt_.queue.enqueueReadBuffer(counterBuf_, CL_TRUE, 0, counts.size() * sizeof(cl_ulong), counts.data());
@@ -163,8 +163,9 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, SceneGrids grid,
   const int first = renderer.samples();
   std::vector<double> kernelMs, wallMs;  // per pass: with one sample per pass, per frame
   const auto tLoop = std::chrono::steady_clock::now();
-  // Samples [done, done + count) per pass; the kernel adds them in index order, so any split of
-  // the same samples (passes, interruption and --resume) gives the same bits.
+  // Samples [done, done + count) per pass (counted from options.sampleBegin); the kernel adds them
+  // exactly (accum.h), so any split of the same samples (passes, interruption and --resume, parts
+  // merged by `narval merge`) gives the same bits.
   while (renderer.samples() < spp && !cancelled(options)) {
     const int count = std::min(perPass, spp - renderer.samples());
     const auto tPass = std::chrono::steady_clock::now();

@@ -1,4 +1,4 @@
-// pathtrace_renderer.h: drives kernels/pathtrace.cl: upload, passes, compensated accumulation.
+// pathtrace_renderer.h: drives kernels/pathtrace.cl: upload, passes, exact accumulation.
 #pragma once
 
 #include <string>
@@ -29,8 +29,8 @@ class PathtraceRenderer {
   void setView(const Scene& view);
   // Starts over from 0 samples.
   void reset();
-  // One launch adding samples [samples(), samples() + count) to every pixel, waited for; returns its
-  // milliseconds by profiling event.
+  // One launch adding the next `count` samples (indices from RenderOptions::sampleBegin +
+  // samples()) to every pixel, waited for; returns its milliseconds by profiling event.
   double addSamples(int count);
   int samples() const { return done_; }
   // The accumulator so far into `into` (image, the state --resume continues from, status, counts).
@@ -42,14 +42,16 @@ class PathtraceRenderer {
 
  private:
   void allocateAccumulator();
+  size_t accumulatorBytes() const;
   ClRuntime& rt_;
   Scene view_;
   RenderOptions options_;
   DeviceSceneBuffers dev_;
   cl::Program program_;
   NamedKernel kernel_;
-  cl::Buffer sumBuf_, compBuf_, statusBuf_, counterBuf_;
-  int first_ = 0, done_ = 0;
+  cl::Buffer accumBuf_, statusBuf_, counterBuf_;
+  int begin_ = 0;               // the first sample index (RenderOptions::sampleBegin)
+  int first_ = 0, done_ = 0;    // samples resumed from, and accumulated, from begin_ on
   RenderStats stats_;
   std::vector<std::string> warnings_;
 };

@@ -6,18 +6,34 @@
 
 #include "cl/cl_runtime.h"
 #include "scene/input_error.h"
+#include "shared/accum.h"
+#include "util/shell_quote.h"
 
 namespace narval {
 namespace {
 
-const char* const kChannels[6] = {"accum_sum.R", "accum_sum.G", "accum_sum.B",
-                                  "accum_comp.R", "accum_comp.G", "accum_comp.B"};
+// The accumulator's UINT channels: per colour four 32-bit words of its 128-bit sum (low first),
+// then the count of rejected samples (accum.h). 64-bit words split into two channels each.
+std::vector<std::string> accumulatorChannelNames() {
+  std::vector<std::string> names;
+  for (const char* c : {"R", "G", "B"})
+    for (int w = 0; w < 4; ++w) names.push_back(std::string("accum.") + c + ".w" + std::to_string(w));
+  names.push_back("accum.rejected");
+  return names;
+}
+
+// Where channel c of accumulatorChannelNames lives: 32-bit word c % 4 of colour c / 4 (bits `shift`
+// of the 64-bit word `word`), and the last channel the rejected count.
+void accumulatorChannelWord(size_t c, size_t* word, int* shift) {
+  *word = c < 12 ? 2 * (c / 4) + (c % 4) / 2 : size_t(ACCUM_REJECTED_WORD);
+  *shift = c < 12 ? 32 * int(c % 2) : 0;
+}
 
 // A non-negative decimal attribute, or an InputError naming it.
 long long attributeNumber(const std::map<std::string, std::string>& attrs, const std::string& path,
                           const std::string& name) {
   const auto it = attrs.find(name);
-  if (it == attrs.end()) throw inputError(path, name, "missing: not a resumable narval path-traced render");
+  if (it == attrs.end()) throw inputError(path, name, "missing: not a narval path-traced render with its samples");
   try {
     size_t used = 0;
     const long long v = std::stoll(it->second, &used);
@@ -45,26 +61,26 @@ std::string& commandLineStore() {
   return text;
 }
 
-// One argument as a POSIX shell reads it back: bare when it is safe, else in single quotes.
-std::string shellQuoted(const std::string& arg) {
-  const bool safe = !arg.empty() && arg.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                                          "0123456789_-+=./:,@%") == std::string::npos;
-  if (safe) return arg;
-  std::string out = "'";
-  for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 }  // namespace
 
 void recordCommandLine(int argc, const char* const* argv) {
-  std::string text;
-  for (int i = 0; i < argc; ++i) text += (i ? " " : "") + shellQuoted(argv[i]);
-  commandLineStore() = text;
+  commandLineStore() = shellJoined(std::vector<std::string>(argv, argv + argc));
 }
 
 const std::string& recordedCommandLine() { return commandLineStore(); }
 
-std::vector<ExrAttribute> renderAttributes(const RenderStats& s, const Scene& scene) {
+RenderIdentity renderIdentity(const Scene& scene) {
+  RenderIdentity id;
+  id.seed = scene.renderer.seed;
+  id.scene = scene.sourcePath;
+  id.renderKey = renderKey(scene);
+  id.exposure = scene.renderer.exposure;
+  id.toneMapping = scene.renderer.toneMapping;
+  id.overrides = scene.overrides;
+  return id;
+}
+
+std::vector<ExrAttribute> renderAttributes(const RenderStats& s, const RenderIdentity& id) {
   const std::time_t now = std::time(nullptr);
   std::tm local{}, utc{};
   localtime_r(&now, &local);
@@ -73,45 +89,100 @@ std::vector<ExrAttribute> renderAttributes(const RenderStats& s, const Scene& sc
   std::strftime(date, sizeof date, "%Y:%m:%d %H:%M:%S", &local);
   // UTC = local + utcOffset (OpenEXR's ImfStandardAttributes.h): mktime reads both as local time.
   const float utcOffset = float(std::difftime(std::mktime(&utc), std::mktime(&local)));
-  return {{"renderTimeSeconds", float(s.seconds)},
+  std::vector<ExrAttribute> attrs = {{"renderTimeSeconds", float(s.seconds)},
           {"samplesPerPixel", s.spp},
           {"capDate", std::string(date)},
           {"utcOffset", utcOffset},
           {"narval:algorithm", s.algorithm},
           {"narval:spp", s.spp},
           {"narval:bounces", s.bounces},
-          {"narval:seed", double(scene.renderer.seed)},  // an unsigned 32-bit seed: exact in a double
-          {"narval:scene", scene.sourcePath},
+          {"narval:seed", double(id.seed)},  // an unsigned 32-bit seed: exact in a double
+          {"narval:scene", id.scene},
           {"narval:device", s.device},
           {"narval:seconds", s.seconds},
           {"narval:status", int(s.status)},
-          {"narval:render_key", renderKey(scene)},
+          {"narval:render_key", id.renderKey},
           // The path tracer's samples also depend on these (RenderOptions): --resume keeps them.
           {"narval:majorant", s.majorant},
           {"narval:majorant_resolution", s.majorantResolution},
-          {"narval:exposure", scene.renderer.exposure},
-          {"narval:tone_mapping", std::string(toneMappingName(scene.renderer.toneMapping))},
+          {"narval:exposure", id.exposure},
+          {"narval:tone_mapping", std::string(toneMappingName(id.toneMapping))},
           {"narval:version", std::string(NARVAL_VERSION)},
           {"narval:command_line", recordedCommandLine()},
-          {"narval:overrides", scene.overrides}};
+          {"narval:overrides", id.overrides}};
+  if (s.algorithm == "pathtrace") {
+    attrs.push_back({"narval:sample_begin", s.sampleBegin});
+    attrs.push_back({"narval:sample_end", s.sampleBegin + s.spp});
+  }
+  return attrs;
 }
 
-void writeRenderExr(const std::string& path, const RenderResult& r, const Scene& scene) {
-  std::vector<ExrChannel> channels;
+void writeRenderExr(const std::string& path, const RenderResult& r, const RenderIdentity& identity) {
+  std::vector<ExrUintChannel> channels;
   const AccumulatorState& acc = r.accumulator;
   const size_t pixels = size_t(r.image.width) * size_t(r.image.height);
-  if (acc.sum.size() == pixels * 4 && acc.comp.size() == pixels * 4) {
-    for (int c = 0; c < 6; ++c) {
-      const std::vector<float>& src = c < 3 ? acc.sum : acc.comp;
-      ExrChannel ch{kChannels[c], std::vector<float>(pixels)};
-      for (size_t i = 0; i < pixels; ++i) ch.values[i] = src[i * 4 + c % 3];
+  if (acc.words.size() == pixels * kAccumulatorWords) {
+    const std::vector<std::string> names = accumulatorChannelNames();
+    for (size_t c = 0; c < names.size(); ++c) {
+      size_t word;
+      int shift;
+      accumulatorChannelWord(c, &word, &shift);
+      ExrUintChannel ch{names[c], std::vector<uint32_t>(pixels)};
+      for (size_t i = 0; i < pixels; ++i) ch.values[i] = uint32_t(acc.words[i * kAccumulatorWords + word] >> shift);
       channels.push_back(std::move(ch));
     }
   }
-  writeExr(path, r.image, renderAttributes(r.stats, scene), channels);
+  writeExr(path, r.image, renderAttributes(r.stats, identity), channels);
 }
 
-AccumulatorState readAccumulator(const std::string& path, const Scene& scene) {
+const std::string& RenderPart::attribute(const std::string& name) const {
+  static const std::string none;
+  const auto it = attributes.find(name);
+  return it == attributes.end() ? none : it->second;
+}
+
+RenderPart readRenderPart(const std::string& path) {
+  RenderPart part;
+  part.path = path;
+  part.attributes = readExrAttributes(path);
+  const auto& attrs = part.attributes;
+  const auto algorithm = attrs.find("narval:algorithm");
+  if (algorithm == attrs.end() || algorithm->second != "pathtrace")
+    throw inputError(path, "narval:algorithm",
+                     algorithm == attrs.end() ? "missing: not a narval path-traced render with its samples"
+                                              : "rendered by " + algorithm->second +
+                                                    "; only path-traced renders carry their samples");
+  if (!attrs.count("narval:sample_begin"))
+    throw inputError(path, "narval:sample_begin",
+                     "missing: rendered by a narval before exact accumulation, whose float sums cannot be continued "
+                     "or merged bit for bit; render it again");
+  const long long begin = attributeNumber(attrs, path, "narval:sample_begin");
+  const long long end = attributeNumber(attrs, path, "narval:sample_end");
+  const long long spp = attributeNumber(attrs, path, "narval:spp");
+  if (end - begin != spp || end > 0x7fffffffLL)
+    throw inputError(path, "narval:sample_end",
+                     "samples [" + std::to_string(begin) + ", " + std::to_string(end) + ") do not hold narval:spp " +
+                         std::to_string(spp));
+  AccumulatorState& acc = part.accumulator;
+  acc.begin = int(begin);
+  acc.samples = int(spp);
+  acc.status = uint32_t(attributeNumber(attrs, path, "narval:status"));
+  const ImageRGB image = readExr(path);
+  part.width = image.width;
+  part.height = image.height;
+  const std::vector<ExrUintChannel> channels = readExrUintChannels(path, accumulatorChannelNames());
+  const size_t pixels = size_t(part.width) * size_t(part.height);
+  acc.words.assign(pixels * kAccumulatorWords, 0);
+  for (size_t c = 0; c < channels.size(); ++c) {
+    size_t word;
+    int shift;
+    accumulatorChannelWord(c, &word, &shift);
+    for (size_t i = 0; i < pixels; ++i) acc.words[i * kAccumulatorWords + word] |= uint64_t(channels[c].values[i]) << shift;
+  }
+  return part;
+}
+
+AccumulatorState readAccumulator(const std::string& path, const Scene& scene, int sampleBegin) {
   const auto attrs = readExrAttributes(path);
   const auto algorithm = attrs.find("narval:algorithm");
   if (algorithm == attrs.end() || algorithm->second != "pathtrace")
@@ -125,26 +196,19 @@ AccumulatorState readAccumulator(const std::string& path, const Scene& scene) {
                      "rendered from other settings than " + scene.sourcePath +
                          " with these options (only spp and display settings may change); render to another file "
                          "or leave out --resume");
-  const long long spp = attributeNumber(attrs, path, "narval:spp");
-  if (spp > scene.renderer.spp)
+  RenderPart part = readRenderPart(path);
+  AccumulatorState& acc = part.accumulator;
+  if (acc.begin != sampleBegin)
+    throw inputError(path, "narval:sample_begin",
+                     "holds samples from " + std::to_string(acc.begin) + " on, not from " + std::to_string(sampleBegin) +
+                         "; resume it with --samples " + std::to_string(acc.begin) + ":END");
+  if (acc.samples > scene.renderer.spp)
     throw inputError(path, "narval:spp",
-                     "has " + std::to_string(spp) + " spp, more than the " + std::to_string(scene.renderer.spp) +
+                     "has " + std::to_string(acc.samples) + " spp, more than the " + std::to_string(scene.renderer.spp) +
                          " requested");
-  AccumulatorState acc;
-  acc.samples = int(spp);
-  acc.status = uint32_t(attributeNumber(attrs, path, "narval:status"));
-  const std::vector<ExrChannel> channels =
-      readExrChannels(path, std::vector<std::string>(std::begin(kChannels), std::end(kChannels)));
-  const size_t pixels = size_t(scene.renderer.width) * size_t(scene.renderer.height);
-  if (channels[0].values.size() != pixels)  // the key covers the resolution; this guards a hand-edited file
+  if (part.width != scene.renderer.width || part.height != scene.renderer.height)  // the key covers the size; this guards a hand-edited file
     throw inputError(path, "narval:render_key", "the image size does not match renderer.resolution");
-  acc.sum.assign(pixels * 4, 0.0f);
-  acc.comp.assign(pixels * 4, 0.0f);
-  for (int c = 0; c < 6; ++c) {
-    std::vector<float>& dst = c < 3 ? acc.sum : acc.comp;
-    for (size_t i = 0; i < pixels; ++i) dst[i * 4 + c % 3] = channels[size_t(c)].values[i];
-  }
-  return acc;
+  return std::move(part.accumulator);
 }
 
 }  // namespace narval

@@ -1,7 +1,8 @@
 // render_exr.h: what a render's EXR carries besides its pixels: header attributes that name the
 // render (algorithm, spp, seed, scene, device, status, a key of the settings), and for the path
-// tracer its accumulator (compensated sum per channel), so that `narval render --resume` continues
-// an interrupted or finished render to more samples with the bits of an uninterrupted one.
+// tracer its sample range and exact accumulator (render/accumulator.h), so that `narval render
+// --resume` continues a render to more samples, and `narval merge` adds renders of disjoint sample
+// ranges, with the bits of one uninterrupted render.
 #pragma once
 
 #include <string>
@@ -24,23 +25,50 @@ std::string renderKey(const Scene& scene);
 void recordCommandLine(int argc, const char* const* argv);
 const std::string& recordedCommandLine();
 
+// What names a render besides its statistics: from the scene when it is rendered, from a part's
+// header when parts are merged (render_merge.h).
+struct RenderIdentity {
+  uint32_t seed = 0;
+  std::string scene, renderKey;  // Scene::sourcePath; renderKey(scene)
+  float exposure = 0.0f;
+  ToneMapping toneMapping = ToneMapping::Aces;
+  std::vector<std::string> overrides;
+};
+RenderIdentity renderIdentity(const Scene& scene);
+
 // The header attributes of a render's EXR, numbers typed as numbers:
 // - pbrt-v4's, which image tools read: renderTimeSeconds (float), samplesPerPixel (int);
 // - OpenEXR's standard capDate ("YYYY:MM:DD hh:mm:ss", local time) and utcOffset (float seconds,
 //   UTC = local time + utcOffset);
 // - narval's: algorithm, spp, bounces, seed, scene, device, seconds, status, render_key, majorant,
-//   majorant_resolution (what --resume checks), exposure and tone_mapping (the scene's display
+//   majorant_resolution (what --resume checks), sample_begin and sample_end (the path tracer's
+//   samples [begin, end), what `narval merge` tiles), exposure and tone_mapping (the scene's display
 //   transform, which `narval compare` applies by default), version, command_line and overrides
 //   (the --set strings, a string vector).
-std::vector<ExrAttribute> renderAttributes(const RenderStats& stats, const Scene& scene);
+std::vector<ExrAttribute> renderAttributes(const RenderStats& stats, const RenderIdentity& identity);
 
 // Writes result.image to `path` (atomically) with renderAttributes and, for the path tracer, the
-// accumulator as six more channels: accum_sum.{R,G,B} and accum_comp.{R,G,B}.
-void writeRenderExr(const std::string& path, const RenderResult& result, const Scene& scene);
+// accumulator as 13 UINT channels: accum.{R,G,B}.w0–w3 (each channel's 128-bit sum, low 32-bit word
+// first) and accum.rejected (samples not added; accum.h).
+void writeRenderExr(const std::string& path, const RenderResult& result, const RenderIdentity& identity);
+
+// A path-traced render as read back from its EXR: header attributes (as text), size, accumulator.
+struct RenderPart {
+  std::string path;
+  std::map<std::string, std::string> attributes;
+  int width = 0, height = 0;
+  AccumulatorState accumulator;
+  const std::string& attribute(const std::string& name) const;  // "" when absent
+};
+
+// Reads a path-traced narval render with its accumulator. InputError "PATH: ATTRIBUTE: ..." when
+// it is not one (another algorithm, no sample range: a render older than exact accumulation).
+RenderPart readRenderPart(const std::string& path);
 
 // Reads the accumulator of an earlier path-traced render of the same scene from `path` for
-// --resume. InputError "PATH: ATTRIBUTE: ..." when the file is not a resumable narval render, was
-// rendered from other settings (renderKey), or has more samples than `scene` asks for.
-AccumulatorState readAccumulator(const std::string& path, const Scene& scene);
+// --resume of samples [sampleBegin, sampleBegin + scene.renderer.spp). InputError "PATH:
+// ATTRIBUTE: ..." when the file is not a resumable narval render, was rendered from other settings
+// (renderKey), starts at another sample or has more samples than asked for.
+AccumulatorState readAccumulator(const std::string& path, const Scene& scene, int sampleBegin);
 
 }  // namespace narval

@@ -8,17 +8,9 @@
 #include <vector>
 
 #include "image/image.h"
+#include "render/accumulator.h"
 
 namespace narval {
-
-// The path tracer's per-pixel compensated sums after `samples` samples per pixel: sum and
-// compensation, RGBA as the kernel keeps them (width*height*4 each). The kernel adds samples in
-// index order to this state, so continuing from it gives the bits of an uninterrupted render.
-struct AccumulatorState {
-  int samples = 0;
-  uint32_t status = 0;  // STATUS_* bits met so far
-  std::vector<float> sum, comp;
-};
 
 struct RenderOptions {
   int localSizeX = 8, localSizeY = 8;  // work-group shape; never changes the pixels
@@ -27,7 +19,11 @@ struct RenderOptions {
   std::function<void(int, int)> progress;
   // Checked before every pass (frame): once true, the render stops and returns what it has.
   const std::atomic<bool>* cancel = nullptr;
-  // pathtrace: continue from this state (same scene, size and seed) instead of from zero.
+  // pathtrace: the first sample index (--samples A:B); the render adds scene.renderer.spp samples
+  // from there. Samples are numbered per pixel, so [A, B) of one render are those of any other.
+  int sampleBegin = 0;
+  // pathtrace: continue from this state (same scene, size and seed; its begin is sampleBegin)
+  // instead of from zero.
   const AccumulatorState* resumeFrom = nullptr;
   // pathtrace: the majorant delta and ratio tracking sample against (kernels/shared/tracking.h):
   // "grid" (per cell of the majorant grid, walked by DDA), "global" (one σ̄ over the box), or "auto"
@@ -68,6 +64,7 @@ struct RenderStats {
   size_t gridBytes = 0, bricks = 0, bricksOccupied = 0;
   int width = 0, height = 0, bounces = 0;
   int spp = 0;                 // samples per pixel in the image (pathtrace: resumed ones included)
+  int sampleBegin = 0;         // pathtrace: the image's samples are [sampleBegin, sampleBegin + spp)
   int sppRequested = 0;        // what the scene asked for; more than spp when interrupted
   int resumedFromSpp = 0;      // pathtrace --resume: samples per pixel the render started from
   bool interrupted = false;    // stopped by RenderOptions::cancel before the requested samples

@@ -190,6 +190,8 @@ Scene parseScene(const std::string& jsonText, const std::string& path,
                  const std::vector<std::string>& overrides = {}, std::set<std::string>* keysAsked = nullptr);
 
 const char* toneMappingName(ToneMapping t);
+// The inverse of toneMappingName ("none", "reinhard", "aces"); false for any other name.
+bool toneMappingFromName(const std::string& name, ToneMapping* out);
 // "auto", "image", "buffer" or "bricks": the scene file's spelling.
 const char* gridStorageName(GridStorage s);
 

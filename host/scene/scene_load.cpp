@@ -590,6 +590,15 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
   return parseScene(text.str(), path, overrides);
 }
 
+bool toneMappingFromName(const std::string& name, ToneMapping* out) {
+  for (const auto& [text, value] : kToneMappings)
+    if (text == name) {
+      *out = value;
+      return true;
+    }
+  return false;
+}
+
 const char* toneMappingName(ToneMapping t) {
   switch (t) {
     case ToneMapping::None: return "none";

@@ -316,7 +316,7 @@ void ViewerSession::writeSnapshot(const RenderResult& result, const Scene& view)
   for (size_t i = 0; i < view.materials.size() && doc.contains("materials") && i < doc["materials"].size(); ++i)
     if (!view.materials[i].path.empty() && doc["materials"][i].contains("path"))
       doc["materials"][i]["path"] = fs::absolute(view.materials[i].path).lexically_normal().string();
-  writeRenderExr(base.string() + ".exr", result, view);
+  writeRenderExr(base.string() + ".exr", result, renderIdentity(view));
   writePng(base.string() + ".png", result.image, view.renderer.exposure, view.renderer.toneMapping);
   writeTextAtomic(base.string() + ".json", doc.dump(2) + "\n");
   messages_.push_back("wrote " + base.string() + ".exr, .png and .json (" + algorithmName(view.renderer.algorithm) + ", " +

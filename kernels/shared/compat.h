@@ -30,9 +30,11 @@ typedef ulong nv_ulong; /* 64-bit unsigned (counters, tracking.h) */
 #define nv_floor floor
 #define nv_isfinite isfinite
 #define nv_pow pow
+#define nv_float_bits(x) as_uint(x)
 #else
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 #define NV_GLOBAL
 #define NV_CONSTANT
 #define NV_PRIVATE
@@ -63,6 +65,12 @@ static inline vec3 vec3_make(float x, float y, float z) {
 #define nv_floor floorf
 #define nv_isfinite isfinite
 #define nv_pow powf
+/* The IEEE-754 bits of a float (OpenCL's as_uint). */
+static inline uint32_t nv_float_bits(float x) {
+  uint32_t bits;
+  memcpy(&bits, &x, sizeof bits);
+  return bits;
+}
 #endif
 
 #define NV_PI 3.14159265358979323846f

@@ -1,6 +1,6 @@
 // fog_scene.h: the CLI tests' path-traced scene: a scattering slab lit from behind, multiple
-// bounces, so samples differ from pixel to pixel and from pass to pass, and the accumulator's
-// compensation term is non-zero.
+// bounces, so samples differ from pixel to pixel and from pass to pass, and every word of the
+// accumulator's fixed-point sums below the top one is busy.
 #pragma once
 
 #include <string>

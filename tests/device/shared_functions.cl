@@ -3,6 +3,7 @@
  * values of the very same code. One work-item per input; every kernel takes the batch size n.
  * Build with -DMEDIUM_HOMOGENEOUS: grid.h then reads density 1 (the host's grid_view with NULL
  * data), which is what the tracking kernels compare against. */
+#include "shared/accum.h"
 #include "shared/camera.h"
 #include "shared/intersect.h"
 #include "shared/light.h"
@@ -11,6 +12,17 @@
 #include "shared/sampling.h"
 #include "shared/scene_kinds.h"
 #include "shared/tracking.h"
+
+/* in: 3 floats per item (a sample's RGB), each added to words that start at start[0..7] -> the
+ * ACCUM_WORDS words after accum_add_sample */
+__kernel void sf_accum_add_sample(__global const float* in, __global const ulong* start, __global ulong* out, uint n) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  ulong words[ACCUM_WORDS];
+  for (int w = 0; w < ACCUM_WORDS; ++w) words[w] = start[w];
+  accum_add_sample(words, vec3_make(in[3 * i], in[3 * i + 1], in[3 * i + 2]));
+  for (int w = 0; w < ACCUM_WORDS; ++w) out[ACCUM_WORDS * i + w] = words[w];
+}
 
 /* in: g[i], mu[i] -> phase_hg_eval */
 __kernel void sf_phase_hg_eval(__global const float* g, __global const float* mu, __global float* out, uint n) {

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <random>
 #include <sstream>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "cl/cl_runtime.h"
+#include "shared/accum.h"
 #include "shared/camera.h"
 #include "shared/intersect.h"
 #include "shared/phase.h"
@@ -252,6 +254,32 @@ TEST_F(SharedOnDevice, PhiloxIsBitIdentical) {
   }
   EXPECT_EQ(mismatches, 0u);
   std::cout << "[ host/device ] philox: " << n << " blocks, " << mismatches << " differing words\n";
+}
+
+// The exact accumulator is integer arithmetic on the float's bits: the device's 128-bit words equal
+// the host's for samples of every exponent the range takes (and NaN, inf, out of range, both signs),
+// added to a start with all carry and borrow paths busy (low word near 2^64, high word odd).
+TEST_F(SharedOnDevice, AccumAddSampleIsBitIdentical) {
+  std::vector<float> in = {0.0f, -0.0f, 1.0f, -1.0f, std::ldexp(1.0f, -64), std::ldexp(1.0f, -66),
+                           std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                           std::ldexp(1.0f, 40), std::nextafter(std::ldexp(1.0f, 40), 0.0f), 1e-45f};
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> m(-1.0f, 1.0f);
+  std::uniform_int_distribution<int> e(-90, 41);
+  while (in.size() % 3 != 0 || in.size() < 30000) in.push_back(std::ldexp(m(gen), e(gen)));
+  const std::vector<cl_ulong> start = {0xfffffffffffffff0ull, 0x8000000000000001ull, 5u, 0u, 0xffffffffffffffffull,
+                                       3u, 1u, 0u};
+  const size_t n = in.size() / 3;
+  const std::vector<cl_ulong> dev = run<cl_ulong>("sf_accum_add_sample", n, ACCUM_WORDS * n, 2, input(in), input(start));
+  size_t mismatches = 0;
+  for (size_t i = 0; i < n; ++i) {
+    uint64_t h[ACCUM_WORDS];
+    for (int w = 0; w < ACCUM_WORDS; ++w) h[w] = start[size_t(w)];
+    accum_add_sample(h, vec3_make(in[3 * i], in[3 * i + 1], in[3 * i + 2]));
+    for (int w = 0; w < ACCUM_WORDS; ++w) mismatches += h[w] != dev[ACCUM_WORDS * i + size_t(w)];
+  }
+  EXPECT_EQ(mismatches, 0u);
+  std::cout << "[ host/device ] accum_add_sample: " << n << " samples, " << mismatches << " differing words\n";
 }
 
 // rng_uniform is integer arithmetic plus an exact conversion: identical floats.

@@ -128,7 +128,8 @@ namespace {
 // Accumulation: no medium, no light, background 0.1 (not a binary fraction): every sample is
 // exactly 0.1f, so after 10⁶ samples the pixel must still be 0.1f to 1e-6 relative. A naive float
 // running sum is off by 0.96% by then (measured: 10⁶ adds of 0.1f give 100958.3; each add rounds at
-// up to ulp(sum)/2 = 2^-8 once the sum passes 65536); the compensated sum stays within a rounding.
+// up to ulp(sum)/2 = 2^-8 once the sum passes 65536); the exact fixed-point sum (accum.h) divided by
+// 10⁶ rounds back to the float it started from.
 TEST(RenderAccumulation, MillionSamplesOfAConstantStayExact) {
   const RenderResult r = render(sceneFromJson(R"({
     "materials": [], "primitives": [],

@@ -147,13 +147,15 @@ TEST(DeviceLimits, RenderersReportAnImageTooLargeForTheDevice) {
   small.selected.info.maxAllocBytes = 1000;
   Scene scene = sceneFromJson(absorptionBoxJson(R"({"resolution": [16, 16], "spp": 1})"));
   scene.sourcePath = "box.json";
-  const std::string tail = " RGBA floats needs 4096 bytes (4.00 KiB), over the largest allocation of device '" +
-                           small.selected.info.name + "', 1000 bytes";
+  const std::string device = "over the largest allocation of device '" + small.selected.info.name + "', 1000 bytes";
+  // The path tracer's accumulator: 8 64-bit words per pixel (accum.h), 16x16x64 = 16384 bytes.
+  const std::string tail = " RGBA floats needs 4096 bytes (4.00 KiB), " + device;
   try {
     renderPathtrace(small, scene, nullptr, {});
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), "box.json: renderer.resolution: an accumulator of 16x16" + tail);
+    EXPECT_EQ(std::string(e.what()),
+              "box.json: renderer.resolution: an accumulator of 16x16 pixels needs 16384 bytes (16.00 KiB), " + device);
   }
   scene.renderer.algorithm = Algorithm::Raymarch;
   try {

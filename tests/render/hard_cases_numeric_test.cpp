@@ -126,7 +126,7 @@ TEST(HardCasesNumeric, PhaseGOfPlusMinusOneIsClampedWithAWarningAndRendersFinite
 // what it hits (Le of the rectangle, or the background); the ray marcher has S_k = 0 and T = e^0 = 1,
 // so L = 0 + 1·L_b = L_b exactly (provided the 0/σt of its energy-conserving step is guarded); the
 // Lobe Estimator finds no density > 0 on the segment and returns L_b exactly. Spp copies of an exact
-// value average to that value bit for bit (the compensated sum; see lobe_test
+// value average to that value bit for bit (the exact sum of accum.h; see RenderAccumulation.
 // MillionSamplesOfAConstantStayExact), so each image equals the expectation exactly.
 //   Scene A: vfov 2°, rectangle light (2, 3, 4) behind the box fills the image: every pixel = Le.
 //   Scene B: no rectangle, a point light (not visible to camera rays), background (0.25, 0.5, 0.75),

@@ -1,6 +1,6 @@
 // tracking_test.cpp: the medium box test (kernels/shared/intersect.h), the host grid reconstruction
 // (kernels/shared/grid.h, host branch), the free-flight and transmittance estimators
-// (kernels/shared/tracking.h) and compensated accumulation (kernels/shared/accum.h), on the host —
+// (kernels/shared/tracking.h), on the host —
 // the very code the device compiles. Every statistical bound is stated with its false-alarm rate;
 // every such test has a control showing the bound is tight enough to see a real error.
 #include <gtest/gtest.h>
@@ -12,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include "shared/accum.h"
 #include "shared/medium.h"
 #include "shared/tracking.h"
 #include "unit/stat_util.h"
@@ -411,24 +410,6 @@ TEST(TrackingDelta, ZeroMajorantEscapesAndIterationCapIsFlagged) {
                                  vec3_make(0, 0, 1), 0.25f, 0.75f, &rng);
   EXPECT_EQ(tr.x, 0.0f);
   EXPECT_EQ(status, static_cast<uint>(STATUS_ITERATION_CAP));
-}
-
-// ---- accum_kahan_add ----
-
-// 10⁶ copies of 0.1f (= 0.100000001490116...) sum to 100000.00149 in exact arithmetic. Compensated
-// float summation lands on the nearest float, 100000.0 (relative error 1.5e-8 < 1e-6); naive float
-// summation drifts to ≈ 100958 (each addition near 1e5 rounds 0.1 to a multiple of 2^-7), a relative
-// error of ~1e-2, asserted > 1e-4 to show the test is sensitive.
-TEST(AccumKahan, MillionTenthsStayExact) {
-  const int n = 1000000;
-  const double exact = n * double(0.1f);
-  float sum = 0.0f, comp = 0.0f, naive = 0.0f;
-  for (int i = 0; i < n; ++i) {
-    accum_kahan_add(&sum, &comp, 0.1f);
-    naive += 0.1f;
-  }
-  EXPECT_LT(std::fabs(sum - exact) / exact, 1e-6) << "kahan sum = " << sum;
-  EXPECT_GT(std::fabs(naive - exact) / exact, 1e-4) << "naive sum = " << naive;
 }
 
 }  // namespace
