@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs missing Debian packages (as root or with passwordless sudo; otherwise prints the apt-get
 # line and stops): the toolchain, PoCL, the libraries, and for the viewer GLFW, GLM and OpenGL, with
-# Xvfb, Mesa and xdotool for its headless tests. Then configures and builds Release into build/ (binary
-# build/narval) and generates the default cloud.
+# Xvfb, Mesa and xdotool for its headless tests; Slurm with munge for the farm tests (a one-node
+# cluster, tests/farm/slurm_cluster.sh) and python3-venv for Open Job Description's runner. Then
+# configures and builds Release into build/ (binary build/narval) and generates the default cloud.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -11,7 +12,8 @@ packages=(build-essential cmake pkg-config
   libopenvdb-dev libboost-iostreams-dev libtbb-dev libopenexr-dev libpng-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev
   clang libclang-rt-dev
-  libglfw3-dev libglm-dev libgl1-mesa-dri libglx-mesa0 xvfb xauth xdotool)
+  libglfw3-dev libglm-dev libgl1-mesa-dri libglx-mesa0 xvfb xauth xdotool
+  slurmctld slurmd slurm-client munge python3-venv)
 
 # The package names are Debian's (12, bookworm) and Ubuntu's; elsewhere say so and build with
 # whatever is installed (CMake names anything missing).

@@ -21,5 +21,6 @@ Command addSweepCommand(CLI::App& app);
 Command addViewCommand(CLI::App& app);
 Command addInfoCommand(CLI::App& app);
 Command addMergeCommand(CLI::App& app);
+Command addFarmCommand(CLI::App& app);
 
 }  // namespace narval

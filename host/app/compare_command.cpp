@@ -55,8 +55,6 @@ RecordedDisplay recordedDisplay(const std::string& reference, const std::string&
   return d;
 }
 
-const std::map<std::string, ToneMapping> kToneMappings = {
-    {"none", ToneMapping::None}, {"reinhard", ToneMapping::Reinhard}, {"aces", ToneMapping::Aces}};
 
 // An output picture must be a .png (its folder is created when it is written).
 void checkPngOutput(const std::string& path, const std::string& option) {
@@ -88,7 +86,8 @@ int runCompare(const CompareArgs& a) {
   checkOutputWritable(a.jndMap, "--jnd-map");
   std::string tmName = a.tonemap;
   for (char& c : tmName) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (!tmName.empty() && !kToneMappings.count(tmName))
+  ToneMapping toneMapping = ToneMapping::None;
+  if (!tmName.empty() && !toneMappingFromName(tmName, &toneMapping))
     throw inputError("--tonemap", "", "expected none, reinhard or aces, got '" + a.tonemap + "'");
 
   const ImageRGB reference = readExr(a.reference);
@@ -97,8 +96,7 @@ int runCompare(const CompareArgs& a) {
   const RecordedDisplay recorded = recordedDisplay(a.reference, a.test);
   const bool anyFlag = a.exposure || !tmName.empty(), allFlags = a.exposure && !tmName.empty();
   if (tmName.empty()) tmName = recorded.found ? recorded.toneMapping : "none";
-  const auto tm = kToneMappings.find(tmName);
-  if (tm == kToneMappings.end())  // a recorded name this build does not know
+  if (!toneMappingFromName(tmName, &toneMapping))  // a recorded name this build does not know
     throw inputError(a.reference, "narval:tone_mapping", "unknown tone mapping '" + tmName + "'");
   const double exposure = a.exposure ? *a.exposure : recorded.found ? recorded.exposure : 0.0;
   const std::string source = allFlags         ? "given"
@@ -107,7 +105,7 @@ int runCompare(const CompareArgs& a) {
                                               : "the default: the EXRs record no common display transform";
   DisplaySettings display;
   display.exposureStops = float(exposure);
-  display.toneMapping = tm->second;
+  display.toneMapping = toneMapping;
   const ImageComparison c = compareImages(reference, test, display, a.reference, a.test);
 
   if (!a.heatmap.empty()) {
@@ -123,7 +121,7 @@ int runCompare(const CompareArgs& a) {
                                       {"width", c.width},
                                       {"height", c.height},
                                       {"exposure", exposure},
-                                      {"tonemap", tm->first},
+                                      {"tonemap", toneMappingName(toneMapping)},
                                       {"display_transform", source},
                                       {"mean_dE76", c.stats76.mean},
                                       {"p95_dE76", c.stats76.p95},
@@ -139,7 +137,7 @@ int runCompare(const CompareArgs& a) {
   std::cout << "reference " << a.reference << "\n"
             << "test      " << a.test << "\n"
             << "          " << c.width << "x" << c.height << ", exposure " << fixed(exposure, 2)
-            << " stops, tone mapping " << tm->first << " (" << source << ")\n\n";
+            << " stops, tone mapping " << toneMappingName(toneMapping) << " (" << source << ")\n\n";
   char header[160];
   std::snprintf(header, sizeof header, "%-8s %10s %10s %10s %10s\n", "", "mean", "p95", "max", "JND%");
   std::cout << header << tableRow("dE76", c.stats76) << tableRow("dE2000", c.stats2000)
