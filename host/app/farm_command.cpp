@@ -2,6 +2,7 @@
 // OUT.exr [--submit]` (farm/farm_job.h, farm/farm_run.h).
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -9,6 +10,7 @@
 
 #include "app/cli_common.h"
 #include "app/commands.h"
+#include "app/farm_cli.h"
 #include "farm/farm_job.h"
 #include "farm/farm_run.h"
 #include "farm/process.h"
@@ -19,6 +21,85 @@
 namespace fs = std::filesystem;
 
 namespace narval {
+namespace {
+
+std::string seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, s >= 100 ? "%.0f s" : "%.3g s", s);
+  return buf;
+}
+
+}  // namespace
+
+std::string thisNarvalBinary() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("narval") : self.string();
+}
+
+int runOrWriteFarmJob(const FarmJob& job, Scheduler scheduler, bool submit, int parallel, const std::string& who) {
+  const std::vector<std::string> files = writeFarmFiles(job, scheduler);
+  std::cout << "wrote";
+  for (const std::string& f : files) std::cout << " " << fs::path(f).filename().string();
+  std::cout << " in " << job.jobDir << "\n";
+  if (!submit) {
+    switch (scheduler) {
+      case Scheduler::Slurm: std::cout << "submit with: sh " << shellQuoted(job.jobDir + "/submit.sh") << "\n"; break;
+      case Scheduler::OpenJd:
+        std::cout << "run with: " << shellJoined(openJdRunCommand(job))
+                  << "\n(or submit the folder to Deadline Cloud: deadline bundle submit " << shellQuoted(job.jobDir) << ")\n";
+        break;
+      case Scheduler::Local: std::cout << "run with: sh " << shellQuoted(job.jobDir + "/run.sh") << "\n"; break;
+    }
+    return 0;
+  }
+
+  const FarmOutcome o = runFarm(job, scheduler, parallel, [&who](const std::string& line) {
+    std::cout << who << ": " << line << "\n" << std::flush;
+  });
+  double taskSum = 0, longest = 0;
+  int failed = 0;
+  for (const FarmTaskOutcome& t : o.tasks) {
+    const std::string what = "task " + std::to_string(t.task) + " " + job.tasks[size_t(t.task)].label;
+    if (!t.ok) {
+      ++failed;
+      std::cerr << "narval: " << who << ": " << what << " failed: no output written; its log: " << job.logPath(t.task)
+                << "\n";
+      continue;
+    }
+    if (t.reused) {
+      std::cout << what << ": output from an earlier run\n";
+      continue;
+    }
+    // Wall time from task.sh's clock; OpenJD runs narval directly, so there only the render's.
+    const double wall = t.wallSeconds >= 0 ? t.wallSeconds : t.renderSeconds;
+    taskSum += wall;
+    longest = std::max(longest, wall);
+    if (t.wallSeconds >= 0)
+      std::cout << what << ": " << seconds(t.wallSeconds) << " (rendering " << seconds(t.renderSeconds) << ")\n";
+    else
+      std::cout << what << ": rendering " << seconds(t.renderSeconds) << "\n";
+  }
+  const std::string step = job.stepNames[1];  // "Merge", "Collect"
+  std::string lower = step;
+  lower[0] = char(std::tolower(static_cast<unsigned char>(lower[0])));
+  if (failed > 0) {
+    std::cerr << "narval: " << who << ": " << failed << " of " << o.tasks.size() << " tasks failed; no " << lower
+              << ", " << job.finalOutput << " not written. Run the same command again to run only the missing tasks.\n";
+    return 1;
+  }
+  if (!o.finalDone) {
+    std::cerr << "narval: " << who << ": the " << lower << " failed; its log: " << job.finalLogPath() << "\n";
+    return 1;
+  }
+  std::cout << lower << ": " << seconds(o.finalSeconds) << "\n";
+  std::cout << "wrote " << job.finalOutput << " (" << o.tasks.size() << " tasks"
+            << (o.schedulerIds.empty() ? "" : "; slurm " + o.schedulerIds) << "): tasks " << seconds(taskSum)
+            << " in all, longest " << seconds(longest) << ", " << seconds(o.wallSeconds) << " from submission to "
+            << lower << "\n";
+  return 0;
+}
+
 namespace {
 
 struct FarmArgs {
@@ -53,17 +134,7 @@ std::vector<std::string> sceneOverrides(const FarmArgs& a) {
   return o;
 }
 
-std::string thisBinary() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? std::string("narval") : self.string();
-}
 
-std::string seconds(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, s >= 100 ? "%.0f s" : "%.3g s", s);
-  return buf;
-}
 
 int runFarmCommand(const FarmArgs& a) {
   Scheduler scheduler = Scheduler::Local;
@@ -95,74 +166,13 @@ int runFarmCommand(const FarmArgs& a) {
                                            "; leave out --submit to write the job only");
   }
 
-  FarmJob job;
-  job.narval = a.narval.empty() ? thisBinary() : fs::absolute(a.narval).string();
-  job.scene = fs::absolute(a.scene).lexically_normal().string();
-  job.renderArgs = renderArgs(a);
-  job.spp = spp;
-  job.tasks = a.tasks;
-  job.jobDir = jobDir.string();
-  job.output = out.lexically_normal().string();
-  job.renderKey = renderKey(scene);
-  job.name = "narval-" + fs::path(a.scene).stem().string();
-  const std::vector<std::string> files = writeFarmFiles(job, scheduler);
+  const std::string narval = a.narval.empty() ? thisNarvalBinary() : fs::absolute(a.narval).string();
+  const FarmJob job = renderFarmJob(narval, fs::absolute(a.scene).lexically_normal().string(), renderArgs(a), spp,
+                                    a.tasks, jobDir.string(), out.lexically_normal().string(), renderKey(scene),
+                                    "narval-" + fs::path(a.scene).stem().string());
   std::cout << "farm: " << job.name << ", " << spp << " spp in " << a.tasks << (a.tasks == 1 ? " task" : " tasks")
-            << " for " << schedulerName(scheduler) << ": wrote";
-  for (const std::string& f : files) std::cout << " " << fs::path(f).filename().string();
-  std::cout << " in " << job.jobDir << "\n";
-  if (!a.submit) {
-    switch (scheduler) {
-      case Scheduler::Slurm: std::cout << "submit with: sh " << shellQuoted(job.jobDir + "/submit.sh") << "\n"; break;
-      case Scheduler::OpenJd:
-        std::cout << "run with: " << shellJoined(openJdRunCommand(job))
-                  << "\n(or submit the folder to Deadline Cloud: deadline bundle submit " << shellQuoted(job.jobDir) << ")\n";
-        break;
-      case Scheduler::Local: std::cout << "run with: sh " << shellQuoted(job.jobDir + "/run.sh") << "\n"; break;
-    }
-    return 0;
-  }
-
-  const FarmOutcome o = runFarm(job, scheduler, a.parallel, [](const std::string& line) {
-    std::cout << "farm: " << line << "\n" << std::flush;
-  });
-  double taskSum = 0, longest = 0;
-  int failed = 0;
-  for (const FarmTaskOutcome& t : o.tasks) {
-    const auto [b, e] = job.range(t.task);
-    const std::string what = "task " + std::to_string(t.task) + " samples [" + std::to_string(b) + ", " +
-                             std::to_string(e) + ")";
-    if (!t.ok) {
-      ++failed;
-      std::cerr << "narval: farm: " << what << " failed: no part written; its log: " << job.logPath(t.task) << "\n";
-      continue;
-    }
-    if (t.reused) {
-      std::cout << what << ": part from an earlier run\n";
-      continue;
-    }
-    // Wall time from task.sh's clock; OpenJD runs narval directly, so there only the render's.
-    const double wall = t.wallSeconds >= 0 ? t.wallSeconds : t.renderSeconds;
-    taskSum += wall;
-    longest = std::max(longest, wall);
-    if (t.wallSeconds >= 0)
-      std::cout << what << ": " << seconds(t.wallSeconds) << " (rendering " << seconds(t.renderSeconds) << ")\n";
-    else
-      std::cout << what << ": rendering " << seconds(t.renderSeconds) << "\n";
-  }
-  if (failed > 0) {
-    std::cerr << "narval: farm: " << failed << " of " << a.tasks << " tasks failed; nothing merged, " << out.string()
-              << " not written. Run the same command again to render only the missing tasks.\n";
-    return 1;
-  }
-  if (!o.merged) {
-    std::cerr << "narval: farm: the merge failed; its log: " << job.mergeLogPath() << "\n";
-    return 1;
-  }
-  std::cout << "merge: " << seconds(o.mergeSeconds) << "\n";
-  std::cout << "wrote " << out.string() << " (" << spp << " spp from " << a.tasks << " parts"
-            << (o.schedulerIds.empty() ? "" : "; slurm " + o.schedulerIds) << "): tasks " << seconds(taskSum)
-            << " in all, longest " << seconds(longest) << ", " << seconds(o.wallSeconds) << " from submission to merge\n";
-  return 0;
+            << " for " << schedulerName(scheduler) << ": ";
+  return runOrWriteFarmJob(job, scheduler, a.submit, a.parallel, "farm");
 }
 
 }  // namespace

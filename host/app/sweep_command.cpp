@@ -1,7 +1,11 @@
 // narval sweep: speed against perceptual error over spp or bounces (dissertation ch. 5). Renders
 // the scene at each value, largest first (the reference, unless --reference FILE.exr), and writes
 // into DIR one EXR per value, sweep.csv, sweep.json and the figure strip sweep.png.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <optional>
 #include <filesystem>
 #include <iostream>
 #include <regex>
@@ -10,6 +14,8 @@
 
 #include "app/cli_common.h"
 #include "app/commands.h"
+#include "app/farm_cli.h"
+#include "farm/farm_job.h"
 #include "render/render_exr.h"
 #include "app/progress_bar.h"
 #include "image/image.h"
@@ -29,7 +35,101 @@ struct SweepArgs {
   std::string scene, out, spp, bounces, reference, device, resolution, algorithm;
   long long seed = -1;
   std::vector<std::string> sets;
+  // As farm tasks (--scheduler): one render per value, then `sweep --collect` of them.
+  std::string scheduler, jobDir, narval;
+  bool submit = false, collect = false;
+  int parallel = 1;
 };
+
+// The sweep's own arguments as its command line spells them (for the farm's --collect step).
+std::vector<std::string> sweepArgv(const SweepArgs& a, const std::string& scene, const std::string& out) {
+  std::vector<std::string> v = {"sweep", scene, "-o", out};
+  if (!a.spp.empty()) v.insert(v.end(), {"--spp", a.spp});
+  if (!a.bounces.empty()) v.insert(v.end(), {"--bounces", a.bounces});
+  if (!a.reference.empty()) v.insert(v.end(), {"--reference", fs::absolute(a.reference).string()});
+  if (!a.resolution.empty()) v.insert(v.end(), {"--resolution", a.resolution});
+  if (a.seed >= 0) v.insert(v.end(), {"--seed", std::to_string(a.seed)});
+  for (const std::string& set : a.sets) v.insert(v.end(), {"--set", set});
+  return v;
+}
+
+// The render key of `base` rendered by `narval render SCENE --algorithm pathtrace --bounces B` with
+// the sweep's overrides: what the farm task for that value writes (render_exr.h).
+std::string taskRenderKey(const Scene& base, int bounces) {
+  std::vector<std::string> overrides = base.overrides;
+  overrides.push_back("renderer.algorithm=\"pathtrace\"");
+  overrides.push_back("renderer.bounces=" + std::to_string(bounces));
+  return renderKey(loadScene(base.sourcePath, overrides));
+}
+
+// The sweep as farm tasks: value V rendered by `narval render` into DIR/<sweepFileName>, the other
+// parameter fixed as the scene has it; then `narval sweep ... --collect` in DIR. A task is done
+// when its EXR is a path-traced render of the scene at V (its render key and spp).
+FarmJob sweepFarmJob(const SweepArgs& a, const Scene& scene, SweepParameter parameter, const std::vector<int>& values,
+                     const std::string& narval, const fs::path& dir, const fs::path& jobDir) {
+  FarmJob job;
+  const std::string sceneFile = fs::absolute(a.scene).lexically_normal().string();
+  job.name = "narval-sweep-" + fs::path(a.scene).stem().string();
+  job.jobDir = jobDir.string();
+  job.narval = narval;
+  job.stepNames = {"Render", "Collect"};
+  std::vector<std::string> keys;
+  std::vector<int> spps;
+  std::vector<int> sorted = values;
+  std::sort(sorted.rbegin(), sorted.rend());  // the order the sweep renders in: largest first
+  for (int v : sorted) {
+    const bool spp = parameter == SweepParameter::Spp;
+    Scene at = scene;
+    (spp ? at.renderer.spp : at.renderer.bounces) = v;
+    FarmTask t;
+    t.output = (dir / sweepFileName(parameter, v)).string();
+    t.label = sweepLabel(parameter, v);
+    t.argv = {narval, "render", sceneFile, "--algorithm", "pathtrace"};
+    for (const std::string& set : a.sets) t.argv.insert(t.argv.end(), {"--set", set});
+    if (!a.resolution.empty()) t.argv.insert(t.argv.end(), {"--resolution", a.resolution});
+    if (a.seed >= 0) t.argv.insert(t.argv.end(), {"--seed", std::to_string(a.seed)});
+    if (!a.device.empty()) t.argv.insert(t.argv.end(), {"--device", a.device});
+    t.argv.insert(t.argv.end(), {"--spp", std::to_string(at.renderer.spp), "--bounces",
+                                 std::to_string(at.renderer.bounces), "-o", t.output, "--quiet"});
+    job.tasks.push_back(t);
+    keys.push_back(taskRenderKey(scene, at.renderer.bounces));
+    spps.push_back(at.renderer.spp);
+  }
+  job.finalArgv = sweepArgv(a, sceneFile, dir.string());
+  job.finalArgv.insert(job.finalArgv.begin(), narval);
+  job.finalArgv.push_back("--collect");
+  job.finalOutput = (dir / "sweep.json").string();
+  job.taskDone = [tasks = job.tasks, keys, spps](int i) {
+    return renderCovers(tasks[size_t(i)].output, keys[size_t(i)], 0, spps[size_t(i)]);
+  };
+  job.finalDone = [out = job.finalOutput] { return fs::exists(out); };
+  return job;
+}
+
+// --collect: a render the farm's task left in DIR, as runSweep takes it: the image and the stats
+// its header records (render_exr.h). InputError when it is missing or not this sweep's.
+RenderResult collectedRender(const Scene& s, const fs::path& exr) {
+  if (!renderCovers(exr.string(), taskRenderKey(s, s.renderer.bounces), 0, s.renderer.spp))
+    throw inputError(exr.string(), "narval:render_key",
+                     "not a path-traced render of " + s.sourcePath + " at " + std::to_string(s.renderer.spp) + " spp and " +
+                         std::to_string(s.renderer.bounces) + " bounces; run the sweep's farm task for it again");
+  const RenderPart part = readRenderPart(exr.string());
+  RenderResult r;
+  r.image = readExr(exr.string());
+  RenderStats& st = r.stats;
+  st.algorithm = "pathtrace";
+  st.device = part.attribute("narval:device");
+  st.width = part.width;
+  st.height = part.height;
+  st.spp = st.sppRequested = part.accumulator.samples;
+  st.bounces = std::atoi(part.attribute("narval:bounces").c_str());
+  st.seconds = std::strtod(part.attribute("narval:seconds").c_str(), nullptr);
+  st.status = part.accumulator.status;
+  st.majorant = part.attribute("narval:majorant");
+  st.majorantResolution = std::atoi(part.attribute("narval:majorant_resolution").c_str());
+  for (float v : r.image.rgb) st.nanPixels += std::isfinite(v) ? 0 : 1;
+  return r;
+}
 
 // One integer option's value (the parameter that stays fixed).
 int parseSingle(const std::string& text, const std::string& option, int minimum) {
@@ -90,9 +190,23 @@ int runSweepCommand(const SweepArgs& a) {
     reference = readExr(a.reference);
     checkSweepReference(scene, reference, a.reference);
   }
+  if (!a.scheduler.empty() && a.collect)
+    throw inputError("--collect", "", "collects what a farm rendered; it does not go with --scheduler");
   // Last of the checks (it makes the folder, so nothing else may refuse after it): the folder takes files.
   checkOutputWritable((dir / "sweep.json").string(), "-o");
-  ClRuntime rt(a.device);
+
+  if (!a.scheduler.empty()) {  // the renders as farm tasks, then this sweep with --collect
+    const Scheduler scheduler = a.scheduler == "slurm"    ? Scheduler::Slurm
+                                : a.scheduler == "openjd" ? Scheduler::OpenJd
+                                                          : Scheduler::Local;
+    const std::string narval = a.narval.empty() ? thisNarvalBinary() : fs::absolute(a.narval).string();
+    const fs::path jobDir = fs::absolute(a.jobDir.empty() ? dir / "farm" : fs::path(a.jobDir)).lexically_normal();
+    const FarmJob job = sweepFarmJob(a, scene, parameter, values, narval, fs::absolute(dir).lexically_normal(), jobDir);
+    std::cout << "sweep: " << job.name << ", " << values.size() << " renders for " << schedulerName(scheduler) << ": ";
+    return runOrWriteFarmJob(job, scheduler, a.submit, a.parallel, "sweep");
+  }
+  std::optional<ClRuntime> rt;
+  if (!a.collect) rt.emplace(a.device);
 
   // ---- render
   fs::create_directories(dir);
@@ -100,10 +214,11 @@ int runSweepCommand(const SweepArgs& a) {
   bool warned = false;
   SweepRenderer render = [&](const Scene& s) {
     const int value = sweepSpp ? s.renderer.spp : s.renderer.bounces;
+    if (a.collect) return collectedRender(s, dir / sweepFileName(parameter, value));
     ProgressBar bar("sweep " + sceneName + ": " + sweepLabel(parameter, value));
     RenderOptions options;
     options.progress = [&bar](int done, int total) { bar.update(done, total); };
-    RenderResult r = renderPathtrace(rt, s, g, options);
+    RenderResult r = renderPathtrace(*rt, s, g, options);
     bar.finish();
     if (!warned)
       for (const std::string& w : r.warnings) std::cerr << "narval: warning: " << w << "\n";
@@ -113,7 +228,8 @@ int runSweepCommand(const SweepArgs& a) {
   auto onRow = [&](const SweepRow& row) {
     const RenderStats& st = row.stats;
     const fs::path exr = dir / sweepFileName(parameter, row.value);
-    writeExr(exr.string(), row.image, renderAttributes(st, renderIdentity(scene)));  // the row's spp and bounces from its stats
+    // The row's spp and bounces from its stats; collected renders are there already.
+    if (!a.collect) writeExr(exr.string(), row.image, renderAttributes(st, renderIdentity(scene)));
     for (const std::string& w : statusWarnings(st.status))
       std::cerr << "narval: warning: " << exr.string() << ": " << w << "\n";
     std::printf("%-14s %10.3f s", sweepLabel(parameter, row.value).c_str(), row.seconds);
@@ -125,6 +241,7 @@ int runSweepCommand(const SweepArgs& a) {
     std::fflush(stdout);
   };
   SweepSpec spec;
+  spec.warmUp = !a.collect;
   spec.parameter = parameter;
   spec.values = values;
   if (!a.reference.empty()) {
@@ -163,6 +280,17 @@ Command addSweepCommand(CLI::App& app) {
   sub->add_option("--seed", a->seed, "Random seed")->check(between(0, 4294967295LL));
   addThreadsOption(sub);
   sub->add_option("--set", a->sets, "Override a scene value: dotted.path=value (repeatable)");
+  sub->add_option("--scheduler", a->scheduler,
+                  "Render the values as farm tasks (narval farm's schedulers: slurm, openjd, local) into DIR, then "
+                  "collect them with --collect; the job goes into DIR/farm (--job-dir)")
+      ->check(CLI::IsMember({"slurm", "openjd", "local"}));
+  sub->add_flag("--submit", a->submit, "With --scheduler: run the job and wait, as narval farm --submit");
+  sub->add_option("--parallel", a->parallel, "With --scheduler local: tasks at once (default 1)")->check(atLeast(1));
+  sub->add_option("--job-dir", a->jobDir, "With --scheduler: the job's folder (default DIR/farm)");
+  sub->add_option("--narval", a->narval, "With --scheduler: the narval binary the tasks run (default: this one)");
+  sub->add_flag("--collect", a->collect,
+                "Compare and tabulate the renders already in DIR (what the farm's tasks wrote; their times are "
+                "their EXRs' narval:seconds) instead of rendering");
   return {sub, [a]() { return runSweepCommand(*a); }};
 }
 

@@ -1,10 +1,7 @@
 #include "farm/farm_job.h"
 
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
-
-#include <nlohmann/json.hpp>
 
 #include "image/atomic_file.h"
 #include "render/render_exr.h"
@@ -23,46 +20,73 @@ const char* schedulerName(Scheduler s) {
   return "?";
 }
 
-std::pair<int, int> FarmJob::range(int task) const {
-  return {int((long long)task * spp / tasks), int((long long)(task + 1) * spp / tasks)};
-}
-std::string FarmJob::partPath(int task) const { return jobDir + "/parts/part_" + std::to_string(task) + ".exr"; }
 std::string FarmJob::logPath(int task) const { return jobDir + "/logs/task_" + std::to_string(task) + ".log"; }
 std::string FarmJob::timePath(int task) const { return jobDir + "/logs/task_" + std::to_string(task) + ".time"; }
-std::string FarmJob::mergeLogPath() const { return jobDir + "/logs/merge.log"; }
-std::string FarmJob::mergeTimePath() const { return jobDir + "/logs/merge.time"; }
+std::string FarmJob::finalLogPath() const { return jobDir + "/logs/final.log"; }
+std::string FarmJob::finalTimePath() const { return jobDir + "/logs/final.time"; }
 
-std::vector<std::string> FarmJob::renderCommand(int task) const {
-  const auto [a, b] = range(task);
-  std::vector<std::string> argv = {narval, "render", scene};
-  argv.insert(argv.end(), renderArgs.begin(), renderArgs.end());
-  argv.insert(argv.end(), {"--samples", std::to_string(a) + ":" + std::to_string(b), "-o", partPath(task), "--quiet"});
-  return argv;
-}
 
-std::vector<std::string> FarmJob::mergeCommand() const {
-  std::vector<std::string> argv = {narval, "merge"};
-  for (int i = 0; i < tasks; ++i) argv.push_back(partPath(i));
-  argv.insert(argv.end(), {"-o", output, "--quiet"});
-  return argv;
+FarmJob renderFarmJob(const std::string& narval, const std::string& scene, const std::vector<std::string>& renderArgs,
+                      int spp, int tasks, const std::string& jobDir, const std::string& output,
+                      const std::string& renderKey, const std::string& name) {
+  FarmJob job;
+  job.name = name;
+  job.jobDir = jobDir;
+  job.narval = narval;
+  std::vector<std::pair<int, int>> ranges;
+  for (int i = 0; i < tasks; ++i) {
+    const int a = int((long long)i * spp / tasks), b = int((long long)(i + 1) * spp / tasks);
+    ranges.push_back({a, b});
+    FarmTask t;
+    t.output = jobDir + "/parts/part_" + std::to_string(i) + ".exr";
+    t.label = "samples [" + std::to_string(a) + ", " + std::to_string(b) + ")";
+    t.argv = {narval, "render", scene};
+    t.argv.insert(t.argv.end(), renderArgs.begin(), renderArgs.end());
+    t.argv.insert(t.argv.end(), {"--samples", std::to_string(a) + ":" + std::to_string(b), "-o", t.output, "--quiet"});
+    job.tasks.push_back(t);
+  }
+  job.finalOutput = output;
+  job.finalArgv = {narval, "merge"};
+  for (const FarmTask& t : job.tasks) job.finalArgv.push_back(t.output);
+  job.finalArgv.insert(job.finalArgv.end(), {"-o", output, "--quiet"});
+  job.taskDone = [tasks = job.tasks, ranges, renderKey](int i) {
+    return renderCovers(tasks[size_t(i)].output, renderKey, ranges[size_t(i)].first, ranges[size_t(i)].second);
+  };
+  job.finalDone = [output, renderKey, spp] { return renderCovers(output, renderKey, 0, spp); };
+  job.openJd = [=] {
+    using nlohmann::json;
+    OpenJdForm f;
+    f.pathParameters = json::array(
+        {{{"name", "Scene"}, {"type", "PATH"}, {"objectType", "FILE"}, {"dataFlow", "IN"}},
+         {{"name", "PartsDir"}, {"type", "PATH"}, {"objectType", "DIRECTORY"}, {"dataFlow", "OUT"}},
+         {{"name", "Output"}, {"type", "PATH"}, {"objectType", "FILE"}, {"dataFlow", "OUT"}}});
+    f.pathValues = {{"Scene", scene}, {"PartsDir", jobDir + "/parts"}, {"Output", output}};
+    json parts = json::array(), samples = json::array();
+    for (int i = 0; i < tasks; ++i) {
+      parts.push_back(i);
+      samples.push_back(std::to_string(ranges[size_t(i)].first) + ":" + std::to_string(ranges[size_t(i)].second));
+    }
+    f.taskParameters = json::array({{{"name", "Part"}, {"type", "INT"}, {"range", parts}},
+                                    {{"name", "Samples"}, {"type", "STRING"}, {"range", samples}}});
+    f.combination = "(Part, Samples)";
+    f.taskArgs = {"render", "{{Param.Scene}}"};
+    for (const std::string& a : renderArgs) f.taskArgs.push_back(a);
+    for (const char* a : {"--samples", "{{Task.Param.Samples}}", "-o", "{{Param.PartsDir}}/part_{{Task.Param.Part}}.exr",
+                          "--quiet"})
+      f.taskArgs.push_back(a);
+    f.finalArgs = {"merge"};
+    for (int i = 0; i < tasks; ++i) f.finalArgs.push_back("{{Param.PartsDir}}/part_" + std::to_string(i) + ".exr");
+    for (const char* a : {"-o", "{{Param.Output}}", "--quiet"}) f.finalArgs.push_back(a);
+    f.taskValues = [samples](int i) { return json{{"Part", i}, {"Samples", samples[size_t(i)]}}; };
+    return f;
+  };
+  return job;
 }
 
 std::vector<int> missingTasks(const FarmJob& job) {
   std::vector<int> missing;
-  for (int i = 0; i < job.tasks; ++i) {
-    bool done = false;
-    if (fs::exists(job.partPath(i))) {
-      try {
-        const RenderPart p = readRenderPart(job.partPath(i));
-        const auto [a, b] = job.range(i);
-        done = p.attribute("narval:render_key") == job.renderKey && p.accumulator.begin == a &&
-               p.accumulator.end() == b;
-      } catch (const std::exception&) {
-        done = false;  // unreadable or not a part: render it again
-      }
-    }
-    if (!done) missing.push_back(i);
-  }
+  for (int i = 0; i < int(job.tasks.size()); ++i)
+    if (!job.taskDone(i)) missing.push_back(i);
   return missing;
 }
 
@@ -78,131 +102,127 @@ std::string timed(const std::string& command, const std::string& timeWord) {
   return "start=$(date +%s.%N)\n" + command + "\nprintf '%s %s\\n' \"$start\" \"$(date +%s.%N)\" > " + timeWord + "\n";
 }
 
+std::string lastTask(const FarmJob& job) { return std::to_string(int(job.tasks.size()) - 1); }
+
 std::string taskScript(const FarmJob& job) {
-  // The range is FarmJob::range's arithmetic, in the shell's (64-bit) integers.
-  std::vector<std::string> render = {job.narval, "render", job.scene};
-  render.insert(render.end(), job.renderArgs.begin(), job.renderArgs.end());
-  const std::string n = std::to_string(job.spp), k = std::to_string(job.tasks);
+  std::string cases;
+  for (size_t i = 0; i < job.tasks.size(); ++i)
+    cases += "  " + std::to_string(i) + ")  # " + job.tasks[i].label + "\n    " + shellJoined(job.tasks[i].argv) + "\n    ;;\n";
   return "#!/bin/sh\n"
-         "# Task I of the narval farm job " + job.name + ": samples [I*" + n + "/" + k + ", (I+1)*" + n + "/" + k +
-         ") of every pixel\n# into parts/part_I.exr, then its start and end times into logs/task_I.time.\n"
-         "# Usage: task.sh I (0 <= I < " + k + "). Written by narval farm.\n"
+         "# One task of the narval farm job " + job.name + " by index (0 to " + lastTask(job) +
+         "): its command below, then its\n# start and end times into logs/task_I.time. Usage: task.sh I. Written by narval.\n"
          "set -eu\n"
-         "i=$1\n"
-         "case $i in ''|*[!0-9]*) echo \"task.sh: not a task index: '$i'\" >&2; exit 2;; esac\n"
-         "if [ \"$i\" -ge " + k + " ]; then echo \"task.sh: no task $i (0 to " + std::to_string(job.tasks - 1) +
-         ")\" >&2; exit 2; fi\n"
          "job=" + shellQuoted(job.jobDir) + "\n"
          "mkdir -p \"$job/logs\"\n" +
-         timed(shellJoined(render) + " \\\n  --samples \"$((i * " + n + " / " + k + ")):$(((i + 1) * " + n + " / " + k +
-                   "))\" -o \"$job/parts/part_$i.exr\" --quiet",
-               "\"$job/logs/task_$i.time\"");
+         timed("case $1 in\n" + cases + "  *)\n    echo \"task.sh: no task '$1' (0 to " + lastTask(job) +
+                   ")\" >&2\n    exit 2\n    ;;\nesac",
+               "\"$job/logs/task_$1.time\"");
 }
 
-std::string mergeScript(const FarmJob& job) {
-  return "#!/bin/sh\n# Merges the parts of the narval farm job " + job.name +
-         " into the output; its times into logs/merge.time.\nset -eu\nmkdir -p " + shellQuoted(job.jobDir + "/logs") +
-         "\n" + timed(shellJoined(job.mergeCommand()), shellQuoted(job.mergeTimePath()));
+std::string finalScript(const FarmJob& job) {
+  return "#!/bin/sh\n# The last step of the narval farm job " + job.name + " (" + job.stepNames[1] +
+         "), once every task has succeeded;\n# its times into logs/final.time.\nset -eu\nmkdir -p " +
+         shellQuoted(job.jobDir + "/logs") + "\n" + timed(shellJoined(job.finalArgv), shellQuoted(job.finalTimePath()));
 }
 
-std::string slurmRenderScript(const FarmJob& job) {
+std::string slurmTaskScript(const FarmJob& job) {
   return "#!/bin/sh\n"
-         "#SBATCH --job-name=" + job.name + "-render\n"
-         "#SBATCH --array=0-" + std::to_string(job.tasks - 1) + "\n"
+         "#SBATCH --job-name=" + job.name + "\n"
+         "#SBATCH --array=0-" + lastTask(job) + "\n"
          "#SBATCH --output=" + job.jobDir + "/logs/task_%a.log\n"
-         "# One array task per sample range (task.sh). Add --cpus-per-task, --time or --partition here or\n"
-         "# on the sbatch line as the cluster needs; the pixels never depend on them.\n"
+         "# One array task per task.sh entry. Add --cpus-per-task, --time or --partition here or on the\n"
+         "# sbatch line as the cluster needs; the pixels never depend on them.\n"
          "exec " + shellQuoted(job.jobDir + "/task.sh") + " \"$SLURM_ARRAY_TASK_ID\"\n";
 }
 
-std::string slurmMergeScript(const FarmJob& job) {
+std::string slurmFinalScript(const FarmJob& job) {
   return "#!/bin/sh\n"
-         "#SBATCH --job-name=" + job.name + "-merge\n"
-         "#SBATCH --output=" + job.mergeLogPath() + "\n"
-         "exec " + shellQuoted(job.jobDir + "/merge.sh") + "\n";
+         "#SBATCH --job-name=" + job.name + "-final\n"
+         "#SBATCH --output=" + job.finalLogPath() + "\n"
+         "exec " + shellQuoted(job.jobDir + "/final.sh") + "\n";
 }
 
 std::string slurmSubmitScript(const FarmJob& job) {
   return "#!/bin/sh\n"
-         "# Submits the render array, then the merge once every task has succeeded (a failed task cancels\n"
-         "# it). Extra arguments go to the array's sbatch, e.g. --array=3,5 to render only tasks 3 and 5.\n"
+         "# Submits the tasks as a job array, then the final step once every task has succeeded (a\n"
+         "# failed task cancels it). Extra arguments go to the array's sbatch, e.g. --array=3,5 to run\n"
+         "# only tasks 3 and 5.\n"
          "set -eu\n"
-         "array=$(sbatch --parsable \"$@\" " + shellQuoted(job.jobDir + "/render.sbatch") + ")\n"
+         "array=$(sbatch --parsable \"$@\" " + shellQuoted(job.jobDir + "/tasks.sbatch") + ")\n"
          "array=${array%%;*}\n"
-         "merge=$(sbatch --parsable --dependency=afterok:$array --kill-on-invalid-dep=yes " +
-         shellQuoted(job.jobDir + "/merge.sbatch") + ")\n"
-         "echo \"render array $array, merge ${merge%%;*}\"\n";
+         "final=$(sbatch --parsable --dependency=afterok:$array --kill-on-invalid-dep=yes " +
+         shellQuoted(job.jobDir + "/final.sbatch") + ")\n"
+         "echo \"task array $array, final job ${final%%;*}\"\n";
 }
 
 std::string localScript(const FarmJob& job) {
-  return "#!/bin/sh\n# The narval farm job " + job.name + " on this machine: every task in turn, then the merge.\nset -eu\n"
-         "i=0\nwhile [ $i -lt " + std::to_string(job.tasks) + " ]; do\n  " + shellQuoted(job.jobDir + "/task.sh") +
-         " $i\n  i=$((i + 1))\ndone\n" + shellQuoted(job.jobDir + "/merge.sh") + "\n";
+  return "#!/bin/sh\n# The narval farm job " + job.name + " on this machine: every task in turn, then the final step.\n"
+         "set -eu\ni=0\nwhile [ $i -le " + lastTask(job) + " ]; do\n  " + shellQuoted(job.jobDir + "/task.sh") +
+         " $i\n  i=$((i + 1))\ndone\n" + shellQuoted(job.jobDir + "/final.sh") + "\n";
 }
 
-// An Open Job Description template (jobtemplate-2023-09). The scene, the parts folder and the
-// output are PATH job parameters, so a Deadline Cloud submission can map them to its workers'
-// storage; OpenJD allows no absolute PATH default, nor one outside the template's folder, so their
-// values come with the submission (openJdParameters; parameter_values.json for Deadline).
+// An Open Job Description template (jobtemplate-2023-09): the tasks' step, then the final step
+// depending on it. With an OpenJdForm, narval runs directly with the files as PATH parameters; else
+// each step runs task.sh's or final.sh's text as an embedded file.
 std::string openJdTemplate(const FarmJob& job) {
   using nlohmann::json;
-  json parts = json::array(), samples = json::array();
-  for (int i = 0; i < job.tasks; ++i) {
-    const auto [a, b] = job.range(i);
-    parts.push_back(i);
-    samples.push_back(std::to_string(a) + ":" + std::to_string(b));
+  json params = json::array({{{"name", "Narval"}, {"type", "STRING"}, {"default", job.narval},
+                              {"description", "The narval binary on the workers"}}});
+  json taskSpace, taskScriptJson, finalScriptJson;
+  if (job.openJd) {
+    const OpenJdForm f = job.openJd();
+    for (const json& p : f.pathParameters) params.push_back(p);
+    taskSpace = {{"taskParameterDefinitions", f.taskParameters}};
+    if (!f.combination.empty()) taskSpace["combination"] = f.combination;
+    taskScriptJson = {{"actions", {{"onRun", {{"command", "{{Param.Narval}}"}, {"args", f.taskArgs}}}}}};
+    finalScriptJson = {{"actions", {{"onRun", {{"command", "{{Param.Narval}}"}, {"args", f.finalArgs}}}}}};
+  } else {
+    json indices = json::array();
+    for (size_t i = 0; i < job.tasks.size(); ++i) indices.push_back(i);
+    taskSpace = {{"taskParameterDefinitions", json::array({{{"name", "Task"}, {"type", "INT"}, {"range", indices}}})}};
+    // OpenJD wants `args` absent rather than empty.
+    auto embedded = [](const std::string& text, const std::vector<std::string>& args) {
+      json run = {{"command", "{{Task.File.Run}}"}};
+      if (!args.empty()) run["args"] = args;
+      return json{{"embeddedFiles", json::array({{{"name", "Run"}, {"type", "TEXT"}, {"runnable", true}, {"data", text}}})},
+                  {"actions", {{"onRun", run}}}};
+    };
+    taskScriptJson = embedded(taskScript(job), {"{{Task.Param.Task}}"});
+    finalScriptJson = embedded(finalScript(job), {});
   }
-  json render = {"render", "{{Param.Scene}}"};
-  for (const std::string& a : job.renderArgs) render.push_back(a);
-  for (const char* a : {"--samples", "{{Task.Param.Samples}}", "-o", "{{Param.PartsDir}}/part_{{Task.Param.Part}}.exr",
-                        "--quiet"})
-    render.push_back(a);
-  json merge = {"merge"};
-  for (int i = 0; i < job.tasks; ++i) merge.push_back("{{Param.PartsDir}}/part_" + std::to_string(i) + ".exr");
-  for (const char* a : {"-o", "{{Param.Output}}", "--quiet"}) merge.push_back(a);
   const json t = {
       {"specificationVersion", "jobtemplate-2023-09"},
       {"name", job.name},
-      {"description", "narval: " + std::to_string(job.spp) + " spp of " + fs::path(job.scene).filename().string() +
-                          " in " + std::to_string(job.tasks) + " sample ranges, then merged bit for bit"},
-      {"parameterDefinitions",
-       json::array({{{"name", "Narval"}, {"type", "STRING"}, {"default", job.narval},
-                     {"description", "The narval binary on the workers"}},
-                    {{"name", "Scene"}, {"type", "PATH"}, {"objectType", "FILE"}, {"dataFlow", "IN"}},
-                    {{"name", "PartsDir"}, {"type", "PATH"}, {"objectType", "DIRECTORY"}, {"dataFlow", "OUT"}},
-                    {{"name", "Output"}, {"type", "PATH"}, {"objectType", "FILE"}, {"dataFlow", "OUT"}}})},
-      {"steps",
-       json::array(
-           {{{"name", "Render"},
-             {"parameterSpace",
-              {{"taskParameterDefinitions",
-                json::array({{{"name", "Part"}, {"type", "INT"}, {"range", parts}},
-                             {{"name", "Samples"}, {"type", "STRING"}, {"range", samples}}})},
-               {"combination", "(Part, Samples)"}}},
-             {"script", {{"actions", {{"onRun", {{"command", "{{Param.Narval}}"}, {"args", render}}}}}}}},
-            {{"name", "Merge"},
-             {"dependencies", json::array({{{"dependsOn", "Render"}}})},
-             {"script", {{"actions", {{"onRun", {{"command", "{{Param.Narval}}"}, {"args", merge}}}}}}}}})}};
+      {"parameterDefinitions", params},
+      {"steps", json::array({{{"name", job.stepNames[0]}, {"parameterSpace", taskSpace}, {"script", taskScriptJson}},
+                             {{"name", job.stepNames[1]},
+                              {"dependencies", json::array({{{"dependsOn", job.stepNames[0]}}})},
+                              {"script", finalScriptJson}}})}};
   return t.dump(2) + "\n";
 }
 
 // Deadline Cloud's job bundle file of parameter values.
-std::string deadlineParameterValues(const FarmJob& job) {
+std::string deadlineParameterValues(const OpenJdForm& f) {
   nlohmann::json values = nlohmann::json::array();
-  for (const auto& [name, value] : openJdParameters(job)) values.push_back({{"name", name}, {"value", value}});
+  for (const auto& [name, value] : f.pathValues) values.push_back({{"name", name}, {"value", value}});
   return nlohmann::json({{"parameterValues", values}}).dump(2) + "\n";
 }
 
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> openJdParameters(const FarmJob& job) {
-  return {{"Scene", job.scene}, {"PartsDir", job.jobDir + "/parts"}, {"Output", job.output}};
-}
-
 std::vector<std::string> openJdRunCommand(const FarmJob& job) {
   std::vector<std::string> argv = {"openjd", "run", job.jobDir + "/template.json"};
-  for (const auto& [name, value] : openJdParameters(job)) argv.insert(argv.end(), {"-p", name + "=" + value});
+  if (job.openJd)
+    for (const auto& [name, value] : job.openJd().pathValues) argv.insert(argv.end(), {"-p", name + "=" + value});
   return argv;
+}
+
+nlohmann::json openJdTaskList(const FarmJob& job, const std::vector<int>& tasks) {
+  nlohmann::json list = nlohmann::json::array();
+  const std::function<nlohmann::json(int)> values =
+      job.openJd ? job.openJd().taskValues : [](int i) { return nlohmann::json{{"Task", i}}; };
+  for (int t : tasks) list.push_back(values(t));
+  return list;
 }
 
 std::vector<std::string> writeFarmFiles(const FarmJob& job, Scheduler scheduler) {
@@ -211,22 +231,23 @@ std::vector<std::string> writeFarmFiles(const FarmJob& job, Scheduler scheduler)
   switch (scheduler) {
     case Scheduler::Slurm:
       files = {{"task.sh", taskScript(job)},
-               {"merge.sh", mergeScript(job)},
-               {"render.sbatch", slurmRenderScript(job)},
-               {"merge.sbatch", slurmMergeScript(job)},
+               {"final.sh", finalScript(job)},
+               {"tasks.sbatch", slurmTaskScript(job)},
+               {"final.sbatch", slurmFinalScript(job)},
                {"submit.sh", slurmSubmitScript(job)}};
       break;
     case Scheduler::OpenJd:
-      files = {{"template.json", openJdTemplate(job)}, {"parameter_values.json", deadlineParameterValues(job)}};
+      files = {{"template.json", openJdTemplate(job)}};
+      if (job.openJd) files.push_back({"parameter_values.json", deadlineParameterValues(job.openJd())});
       break;
     case Scheduler::Local:
-      files = {{"task.sh", taskScript(job)}, {"merge.sh", mergeScript(job)}, {"run.sh", localScript(job)}};
+      files = {{"task.sh", taskScript(job)}, {"final.sh", finalScript(job)}, {"run.sh", localScript(job)}};
       break;
   }
   std::vector<std::string> written;
   for (const auto& [name, text] : files) {
     const std::string path = job.jobDir + "/" + name;
-    if (name.size() > 5 && name.substr(name.size() - 5) == ".json") writeTextAtomic(path, text);
+    if (fs::path(name).extension() == ".json") writeTextAtomic(path, text);
     else writeScript(path, text);
     written.push_back(path);
   }

@@ -1,55 +1,85 @@
-// farm_job.h: one path-traced render split into K sample ranges, as a job for a scheduler: each task
-// renders `narval render SCENE --samples A:B` into JOB/parts/part_I.exr, and one last task merges
-// them (`narval merge`, render/render_merge.h) into the output, bit for bit the single render.
-// The job folder holds what the scheduler runs (farm_files.h) and its logs.
+// farm_job.h: work split into independent tasks and one final step, written as a job for a
+// scheduler. Two kinds: a path-traced render split into sample ranges (renderFarmJob: each task
+// `narval render --samples A:B` into JOB/parts, then `narval merge`, bit for bit the single
+// render; render/render_merge.h), and a sweep's renders (sweep_command.cpp: one render per value,
+// then `narval sweep --collect`). The job folder holds the scripts (writeFarmFiles), the logs, and
+// for renders the parts.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 namespace narval {
 
 enum class Scheduler { Slurm, OpenJd, Local };
 const char* schedulerName(Scheduler s);  // "slurm", "openjd", "local"
 
-struct FarmJob {
-  std::string narval;                   // the binary every task runs (absolute)
-  std::string scene;                    // the scene file (absolute)
-  std::vector<std::string> renderArgs;  // options every task's render takes (--set, --seed, ...)
-  int spp = 0, tasks = 0;
-  std::string jobDir, output;           // absolute
-  std::string renderKey;                // the scene's with these options (render_exr.h)
-  std::string name;                     // the job's name: "narval-" + the scene's stem
-
-  // Samples [i·N/K, (i+1)·N/K) of task i: contiguous, uneven by at most one sample.
-  std::pair<int, int> range(int task) const;
-  std::string partPath(int task) const;  // JOB/parts/part_I.exr
-  std::string logPath(int task) const;   // JOB/logs/task_I.log
-  std::string timePath(int task) const;  // JOB/logs/task_I.time: start and end, seconds since the epoch
-  std::string mergeLogPath() const;      // JOB/logs/merge.log
-  std::string mergeTimePath() const;     // JOB/logs/merge.time
-  // The render and merge command lines a task runs (argv).
-  std::vector<std::string> renderCommand(int task) const;
-  std::vector<std::string> mergeCommand() const;
+struct FarmTask {
+  std::vector<std::string> argv;  // the command it runs (the narval binary first)
+  std::string output;             // the file it writes
+  std::string label;              // its name in reports: "samples [0, 3)", "spp 100"
 };
 
-// Tasks whose part is not there yet as a finished render of this job's range and render key (so a
-// failed or killed task, or a part of another render, is rendered again); ascending.
+// An Open Job Description form of a job whose tasks differ only in their task parameters, with
+// the files as PATH job parameters (a Deadline Cloud submission maps them to its workers' storage).
+// Jobs without one get a template that runs task.sh's commands as an embedded file.
+struct OpenJdForm {
+  nlohmann::json pathParameters;   // PATH parameter definitions (no defaults: OpenJD allows none absolute)
+  std::vector<std::pair<std::string, std::string>> pathValues;  // their values for this job
+  nlohmann::json taskParameters;   // the first step's taskParameterDefinitions
+  std::string combination;         // e.g. "(Part, Samples)"; "" for one parameter
+  nlohmann::json taskArgs, finalArgs;  // the two steps' narval arguments, with {{...}} references
+  std::function<nlohmann::json(int task)> taskValues;  // task i's parameter values (openjd --tasks)
+};
+
+struct FarmJob {
+  std::string name;        // the job's name, e.g. "narval-cloud"
+  std::string jobDir;      // absolute
+  std::string narval;      // the binary the tasks run (absolute)
+  std::vector<std::string> stepNames = {"Render", "Merge"};  // the tasks' step and the final one
+  std::vector<FarmTask> tasks;
+  std::vector<std::string> finalArgv;
+  std::string finalOutput;
+  // Whether task i's output is there and is what it must be (so a failed, killed or foreign
+  // output makes it run again); whether the final output is this job's.
+  std::function<bool(int task)> taskDone;
+  std::function<bool()> finalDone;
+  std::function<OpenJdForm()> openJd;  // null: the generic template
+
+  std::string logPath(int task) const;   // JOB/logs/task_I.log
+  std::string timePath(int task) const;  // JOB/logs/task_I.time: start and end, seconds since the epoch
+  std::string finalLogPath() const;      // JOB/logs/final.log
+  std::string finalTimePath() const;     // JOB/logs/final.time
+};
+
+// A path-traced render of `scene` (absolute) with `renderArgs` (render's flags: --set, --seed, ...),
+// `spp` samples split into `tasks` ranges [iN/K, (i+1)N/K) (contiguous, uneven by at most one
+// sample), parts in JOB/parts/part_I.exr, merged into `output`; `renderKey` is the scene's with
+// those flags (render_exr.h), what a finished part must carry.
+FarmJob renderFarmJob(const std::string& narval, const std::string& scene, const std::vector<std::string>& renderArgs,
+                      int spp, int tasks, const std::string& jobDir, const std::string& output,
+                      const std::string& renderKey, const std::string& name);
+
+// Tasks whose output is not (yet) what it must be; ascending.
 std::vector<int> missingTasks(const FarmJob& job);
 
 // Writes the job's files for `scheduler` into job.jobDir (made if missing) and returns their paths:
-// - every scheduler: task.sh (one task by index) and merge.sh, which record their times;
-// - slurm: render.sbatch (a job array over the tasks), merge.sbatch and submit.sh, which submits
-//   the array and the merge with --dependency=afterok:ARRAY;
-// - openjd: template.json (jobtemplate-2023-09: a Render step over (Part, Samples), a Merge step
-//   depending on it) and parameter_values.json: the folder is a Deadline Cloud job bundle;
-// - local: run.sh, which runs the tasks one after another and then the merge.
+// - slurm and local: task.sh (one task by index: a case table of the commands) and final.sh, which
+//   record their times; slurm adds tasks.sbatch (a job array over the tasks), final.sbatch and
+//   submit.sh, which submits the array and then the final job with --dependency=afterok:ARRAY;
+//   local adds run.sh (every task in turn, then the final step);
+// - openjd: template.json (jobtemplate-2023-09: a step over the tasks, the final step depending on
+//   it) and, for a job with an OpenJdForm, Deadline's parameter_values.json: the folder is a
+//   Deadline Cloud job bundle.
 std::vector<std::string> writeFarmFiles(const FarmJob& job, Scheduler scheduler);
 
-// The OpenJD template's PATH parameters and their values for this job (Scene, PartsDir, Output).
-std::vector<std::pair<std::string, std::string>> openJdParameters(const FarmJob& job);
-// `openjd run JOB/template.json -p NAME=VALUE...`: the whole job on this machine.
+// `openjd run JOB/template.json [-p NAME=VALUE...]`: the whole job on this machine.
 std::vector<std::string> openJdRunCommand(const FarmJob& job);
+// openjd run's --tasks value for these tasks of the first step.
+nlohmann::json openJdTaskList(const FarmJob& job, const std::vector<int>& tasks);
 
 }  // namespace narval

@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "farm/process.h"
-#include "render/render_exr.h"
+#include "image/image.h"
 
 namespace fs = std::filesystem;
 
@@ -63,56 +63,40 @@ void runLocalTasks(const FarmJob& job, const std::vector<int>& tasks, int parall
   }
 }
 
-void runLocalMerge(const FarmJob& job) {
-  waitProcess(startProcess({"sh", job.jobDir + "/merge.sh"}, job.mergeLogPath()));
+void runLocalFinal(const FarmJob& job) {
+  waitProcess(startProcess({"sh", job.jobDir + "/final.sh"}, job.finalLogPath()));
 }
 
-// The array over `tasks` (none: the merge alone), then the merge depending on it.
+// The array over `tasks` (none: the final job alone), then the final job depending on it.
 std::string submitSlurm(const FarmJob& job, const std::vector<int>& tasks) {
   std::string list, array;
   for (int t : tasks) list += (list.empty() ? "" : ",") + std::to_string(t);
-  std::vector<std::string> merge = {"sbatch", "--parsable", "--wait"};
+  std::vector<std::string> final = {"sbatch", "--parsable", "--wait"};
   if (!tasks.empty()) {
-    array = schedulerCommand({"sbatch", "--parsable", "--array=" + list, job.jobDir + "/render.sbatch"});
+    array = schedulerCommand({"sbatch", "--parsable", "--array=" + list, job.jobDir + "/tasks.sbatch"});
     array = array.substr(0, array.find_first_of(";\n"));
-    merge.insert(merge.end(), {"--dependency=afterok:" + array, "--kill-on-invalid-dep=yes"});
+    final.insert(final.end(), {"--dependency=afterok:" + array, "--kill-on-invalid-dep=yes"});
   }
-  merge.push_back(job.jobDir + "/merge.sbatch");
-  // --wait returns when the merge ends, whether it ran or was cancelled (a failed task cancels it);
-  // which one is read from the files afterwards.
+  final.push_back(job.jobDir + "/final.sbatch");
+  // --wait returns when the final job ends, whether it ran or was cancelled (a failed task cancels
+  // it); which one is read from the files afterwards.
   std::string out, err;
-  const ProcessEnd end = runCapturing(merge, &out, &err);
+  const ProcessEnd end = runCapturing(final, &out, &err);
   const std::string id = out.substr(0, out.find_first_of(";\n"));
-  if (id.empty()) throw std::runtime_error("sbatch of the merge failed (" + end.describe() + "): " + firstLine(err));
-  return (array.empty() ? "" : "array " + array + ", ") + "merge " + id;
+  if (id.empty()) throw std::runtime_error("sbatch of the final job failed (" + end.describe() + "): " + firstLine(err));
+  return (array.empty() ? "" : "array " + array + ", ") + "final job " + id;
 }
 
-// Whether `job.output` is this job's merged render of [0, N).
-bool mergedOutput(const FarmJob& job) {
-  try {
-    const RenderPart p = readRenderPart(job.output);
-    return p.attribute("narval:render_key") == job.renderKey && p.accumulator.begin == 0 &&
-           p.accumulator.end() == job.spp;
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
-// OpenJD runs narval itself, not task.sh: the merge's time is its step's, as measured here.
+// OpenJD may run narval itself, not final.sh: the final step's time is measured here.
 double runOpenJd(const FarmJob& job, const std::vector<int>& tasks) {
-  nlohmann::json list = nlohmann::json::array();
-  for (int t : tasks) {
-    const auto [a, b] = job.range(t);
-    list.push_back({{"Part", t}, {"Samples", std::to_string(a) + ":" + std::to_string(b)}});
-  }
   // openjd prints everything on stdout; the logs keep it. A failed task ends the run (exit 1).
-  std::vector<std::string> render = openJdRunCommand(job), merge = render;
-  render.insert(render.end(), {"--step", "Render", "--tasks", list.dump()});
-  merge.insert(merge.end(), {"--step", "Merge"});
-  const bool rendered = tasks.empty() || waitProcess(startProcess(render, job.jobDir + "/logs/openjd_render.log")).ok();
-  if (!rendered) return -1;
+  std::vector<std::string> first = openJdRunCommand(job), last = first;
+  first.insert(first.end(), {"--step", job.stepNames[0], "--tasks", openJdTaskList(job, tasks).dump()});
+  last.insert(last.end(), {"--step", job.stepNames[1]});
+  const bool ran = tasks.empty() || waitProcess(startProcess(first, job.jobDir + "/logs/openjd_tasks.log")).ok();
+  if (!ran) return -1;
   const auto t0 = std::chrono::steady_clock::now();
-  waitProcess(startProcess(merge, job.mergeLogPath()));
+  waitProcess(startProcess(last, job.finalLogPath()));
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -123,44 +107,45 @@ FarmOutcome runFarm(const FarmJob& job, Scheduler scheduler, int parallel,
   const auto t0 = std::chrono::steady_clock::now();
   fs::create_directories(job.jobDir + "/logs");
   const std::vector<int> todo = missingTasks(job);
-  std::vector<bool> reused(size_t(job.tasks), true);
+  std::vector<bool> reused(job.tasks.size(), true);
   for (int t : todo) reused[size_t(t)] = false;
   FarmOutcome o;
-  if (todo.size() < size_t(job.tasks))
-    say(std::to_string(job.tasks - int(todo.size())) + " of " + std::to_string(job.tasks) +
-        " tasks already have their part; running the other " + std::to_string(todo.size()));
-  fs::remove(job.mergeTimePath());
+  const int count = int(job.tasks.size());
+  if (int(todo.size()) < count)
+    say(std::to_string(count - int(todo.size())) + " of " + std::to_string(count) +
+        " tasks already have their output; running the other " + std::to_string(todo.size()));
+  fs::remove(job.finalTimePath());
   for (int t : todo) fs::remove(job.timePath(t));
   // The output counts as merged only when this run wrote it (an older one may be there).
   std::error_code ec;
-  const auto outputTime = fs::last_write_time(job.output, ec);
+  const auto outputTime = fs::last_write_time(job.finalOutput, ec);
   const bool outputExisted = !ec;
-  double openJdMergeSeconds = -1;
+  double openJdFinalSeconds = -1;
   switch (scheduler) {
     case Scheduler::Local:
       if (!todo.empty()) runLocalTasks(job, todo, parallel, say);
-      if (missingTasks(job).empty()) runLocalMerge(job);
+      if (missingTasks(job).empty()) runLocalFinal(job);
       break;
     case Scheduler::Slurm:
       o.schedulerIds = submitSlurm(job, todo);
       break;
     case Scheduler::OpenJd:
-      openJdMergeSeconds = runOpenJd(job, todo);
+      openJdFinalSeconds = runOpenJd(job, todo);
       break;
   }
   const std::vector<int> missing = missingTasks(job);
-  for (int t = 0; t < job.tasks; ++t) {
+  for (int t = 0; t < count; ++t) {
     FarmTaskOutcome r;
     r.task = t;
     r.ok = std::find(missing.begin(), missing.end(), t) == missing.end();
     r.reused = reused[size_t(t)];
     r.wallSeconds = timeFileSeconds(job.timePath(t));
-    if (r.ok) r.renderSeconds = std::atof(readRenderPart(job.partPath(t)).attribute("narval:seconds").c_str());
+    if (r.ok) r.renderSeconds = std::atof(readExrAttributes(job.tasks[size_t(t)].output)["narval:seconds"].c_str());
     o.tasks.push_back(r);
   }
-  o.mergeSeconds = scheduler == Scheduler::OpenJd ? openJdMergeSeconds : timeFileSeconds(job.mergeTimePath());
-  const auto newTime = fs::last_write_time(job.output, ec);
-  o.merged = missing.empty() && mergedOutput(job) && (!outputExisted || (!ec && newTime != outputTime));
+  o.finalSeconds = scheduler == Scheduler::OpenJd ? openJdFinalSeconds : timeFileSeconds(job.finalTimePath());
+  const auto newTime = fs::last_write_time(job.finalOutput, ec);
+  o.finalDone = missing.empty() && job.finalDone() && (!outputExisted || (!ec && newTime != outputTime));
   o.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return o;
 }

@@ -1,6 +1,7 @@
 #include "render/render_exr.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <ctime>
 #include <stdexcept>
 
@@ -180,6 +181,17 @@ RenderPart readRenderPart(const std::string& path) {
     for (size_t i = 0; i < pixels; ++i) acc.words[i * kAccumulatorWords + word] |= uint64_t(channels[c].values[i]) << shift;
   }
   return part;
+}
+
+bool renderCovers(const std::string& path, const std::string& renderKey, int begin, int end) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return false;
+  try {
+    const RenderPart p = readRenderPart(path);
+    return p.attribute("narval:render_key") == renderKey && p.accumulator.begin == begin && p.accumulator.end() == end;
+  } catch (const std::exception&) {
+    return false;  // unreadable, or not a path-traced render with its samples
+  }
 }
 
 AccumulatorState readAccumulator(const std::string& path, const Scene& scene, int sampleBegin) {

@@ -65,6 +65,10 @@ struct RenderPart {
 // it is not one (another algorithm, no sample range: a render older than exact accumulation).
 RenderPart readRenderPart(const std::string& path);
 
+// Whether `path` is a readable path-traced render with this render key and samples [begin, end):
+// what a farm task must have left (a part, or one of a sweep's renders).
+bool renderCovers(const std::string& path, const std::string& renderKey, int begin, int end);
+
 // Reads the accumulator of an earlier path-traced render of the same scene from `path` for
 // --resume of samples [sampleBegin, sampleBegin + scene.renderer.spp). InputError "PATH:
 // ATTRIBUTE: ..." when the file is not a resumable narval render, was rendered from other settings

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <future>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -76,7 +77,7 @@ TEST_F(FarmCli, LocalTasksMergeToTheBitsOfOneRender) {
   RunResult r = run("farm fog.json --tasks 5 --scheduler local -o out.exr --submit --parallel 2");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out.substr(0, r.out.find('\n')),
-            "farm: narval-fog, 12 spp in 5 tasks for local: wrote task.sh merge.sh run.sh in " + file("out.farm"));
+            "farm: narval-fog, 12 spp in 5 tasks for local: wrote task.sh final.sh run.sh in " + file("out.farm"));
   for (const char* task : {"task 0 samples [0, 2): ", "task 1 samples [2, 4): ", "task 2 samples [4, 7): ",
                            "task 3 samples [7, 9): ", "task 4 samples [9, 12): ", "\nmerge: ",
                            "\nwrote " })
@@ -86,7 +87,7 @@ TEST_F(FarmCli, LocalTasksMergeToTheBitsOfOneRender) {
 
   r = run("farm fog.json --tasks 3 --scheduler local -o again.exr");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(r.out, "farm: narval-fog, 12 spp in 3 tasks for local: wrote task.sh merge.sh run.sh in " +
+  EXPECT_EQ(r.out, "farm: narval-fog, 12 spp in 3 tasks for local: wrote task.sh final.sh run.sh in " +
                        file("again.farm") + "\nrun with: sh " + file("again.farm/run.sh") + "\n");
   EXPECT_FALSE(fs::exists(dir_ / "again.exr"));
   r = runCommand("sh again.farm/run.sh");
@@ -120,19 +121,19 @@ TEST_F(FarmCli, AKilledTaskIsReportedAndRunningAgainRendersOnlyIt) {
   const std::string farm = "farm fog.json --tasks 3 --scheduler local -o out.exr --submit";
   const RunResult r = farmKillingTask(farm, "4000:8000", std::chrono::milliseconds(300));
   EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_EQ(r.err, "narval: farm: task 1 samples [4000, 8000) failed: no part written; its log: " +
+  EXPECT_EQ(r.err, "narval: farm: task 1 samples [4000, 8000) failed: no output written; its log: " +
                        file("out.farm/logs/task_1.log") +
-                       "\nnarval: farm: 1 of 3 tasks failed; nothing merged, " + file("out.exr") +
-                       " not written. Run the same command again to render only the missing tasks.\n");
+                       "\nnarval: farm: 1 of 3 tasks failed; no merge, " + file("out.exr") +
+                       " not written. Run the same command again to run only the missing tasks.\n");
   // The shell running task.sh exits with its child's status: 128 + SIGKILL.
   EXPECT_NE(r.out.find("farm: task 1: exit code 137\n"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
   const RunResult again = run(farm);
   ASSERT_EQ(again.code, 0) << again.err;
-  EXPECT_NE(again.out.find("farm: 2 of 3 tasks already have their part; running the other 1\n"), std::string::npos)
+  EXPECT_NE(again.out.find("farm: 2 of 3 tasks already have their output; running the other 1\n"), std::string::npos)
       << again.out;
-  EXPECT_NE(again.out.find("task 0 samples [0, 4000): part from an earlier run\n"), std::string::npos);
-  EXPECT_NE(again.out.find("task 2 samples [8000, 12000): part from an earlier run\n"), std::string::npos);
+  EXPECT_NE(again.out.find("task 0 samples [0, 4000): output from an earlier run\n"), std::string::npos);
+  EXPECT_NE(again.out.find("task 2 samples [8000, 12000): output from an earlier run\n"), std::string::npos);
   EXPECT_NE(again.out.find("task 1 samples [4000, 8000): "), std::string::npos);
   expectWhole("out.exr");
 }
@@ -156,25 +157,26 @@ TEST_F(FarmCli, SlurmRunsTheTasksAsAnArrayAndTheMergeAfterThem) {
   RunResult r = run("farm fog.json --tasks 4 --scheduler slurm -o out.exr --submit");
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("; slurm array "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(", final job "), std::string::npos) << r.out;
   expectWhole("out.exr");
   // Slurm wrote the logs (sbatch --output), and the scripts name the array and the dependency.
   EXPECT_TRUE(fs::exists(dir_ / "out.farm/logs/task_3.log"));
-  EXPECT_TRUE(fs::exists(dir_ / "out.farm/logs/merge.log"));
-  EXPECT_NE(test::readFile(dir_ / "out.farm/render.sbatch").find("#SBATCH --array=0-3\n"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir_ / "out.farm/logs/final.log"));
+  EXPECT_NE(test::readFile(dir_ / "out.farm/tasks.sbatch").find("#SBATCH --array=0-3\n"), std::string::npos);
   EXPECT_NE(test::readFile(dir_ / "out.farm/submit.sh").find("--dependency=afterok:$array"), std::string::npos);
 
   scene(64, 48, 12000);
   const std::string farm = "farm fog.json --tasks 3 --scheduler slurm -o killed.exr --submit";
   r = farmKillingTask(farm, "4000:8000", std::chrono::milliseconds(300));
   EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_NE(r.err.find("narval: farm: task 1 samples [4000, 8000) failed: no part written; its log: " +
+  EXPECT_NE(r.err.find("narval: farm: task 1 samples [4000, 8000) failed: no output written; its log: " +
                        file("killed.farm/logs/task_1.log")),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "killed.exr"));
   r = run(farm);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("farm: 2 of 3 tasks already have their part; running the other 1\n"), std::string::npos)
+  EXPECT_NE(r.out.find("farm: 2 of 3 tasks already have their output; running the other 1\n"), std::string::npos)
       << r.out;
   expectWhole("killed.exr");
 }
@@ -205,6 +207,59 @@ TEST_F(FarmCli, OpenJdTemplatePassesCheckAndRunsToTheSameBits) {
                  "' farm fog.json --tasks 2 --scheduler openjd -o submitted.exr --submit");
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   expectWhole("submitted.exr");
+}
+
+// The CSV's columns after `seconds` and `speedup` (which are timings): value and the errors.
+std::string errorColumns(const std::string& csv) {
+  std::string out;
+  std::istringstream lines(csv);
+  for (std::string line; std::getline(lines, line);) {
+    std::vector<std::string> cells;
+    std::istringstream row(line);
+    for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+    out += cells.at(0);
+    for (size_t i = 3; i < cells.size(); ++i) out += "," + cells[i];
+    out += "\n";
+  }
+  return out;
+}
+
+// sweep --scheduler local --submit: one render task per value, then `sweep --collect`: the same
+// renders (bit for bit) and the same errors as the sweep run in one process; the OpenJD form of
+// the same job (a template with the task commands as an embedded script) passes openjd check and
+// runs to the same table. --collect with a render missing names it, exit 2.
+TEST_F(FarmCli, SweepAsFarmTasksGivesTheSameRendersAndErrors) {
+  write("fog.json", test::fogSceneJson(16, 12, 12));
+  RunResult r = run("sweep fog.json --spp 3,6,12 -o plain");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("sweep fog.json --spp 3,6,12 -o farmed --scheduler local --submit");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.substr(0, r.out.find('\n')), "sweep: narval-sweep-fog, 3 renders for local: wrote task.sh final.sh "
+                                                 "run.sh in " + file("farmed/farm"));
+  EXPECT_NE(r.out.find("task 0 12 spp: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\ncollect: "), std::string::npos) << r.out;
+  for (const char* exr : {"spp_00003.exr", "spp_00006.exr", "spp_00012.exr"})
+    test::expectSameBits(file(std::string("plain/") + exr), file(std::string("farmed/") + exr), {"R", "G", "B"});
+  EXPECT_EQ(errorColumns(test::readFile(dir_ / "farmed/sweep.csv")), errorColumns(test::readFile(dir_ / "plain/sweep.csv")));
+  EXPECT_TRUE(fs::exists(dir_ / "farmed/sweep.png"));
+
+  fs::remove(dir_ / "farmed/spp_00006.exr");
+  r = run("sweep fog.json --spp 3,6,12 -o farmed --collect");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "narval: farmed/spp_00006.exr: narval:render_key: not a path-traced render of fog.json at 6 spp and "
+                   "6 bounces; run the sweep's farm task for it again\n");
+
+  const char* env = std::getenv("NARVAL_OPENJD");
+  const std::string openjd = env && *env ? env : "openjd";
+  if (runCommand("command -v '" + openjd + "'").code != 0)
+    NARVAL_SKIP_WITHOUT_FARM_TOOL("no openjd (pip install openjd-cli; scripts/test.sh installs it into build/)");
+  r = run("sweep fog.json --spp 3,6,12 -o oj --scheduler openjd");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = runCommand("'" + openjd + "' check oj/farm/template.json");
+  EXPECT_EQ(r.code, 0) << r.out;
+  r = runCommand("'" + openjd + "' run oj/farm/template.json");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_EQ(errorColumns(test::readFile(dir_ / "oj/sweep.csv")), errorColumns(test::readFile(dir_ / "plain/sweep.csv")));
 }
 
 }  // namespace
