@@ -53,9 +53,10 @@ class FarmCli : public test::CliFixture {
   // run for `after`; the farm's result.
   RunResult farmKillingTask(const std::string& args, const std::string& samples, std::chrono::milliseconds after) {
     auto farm = std::async(std::launch::async, [&] { return run(args); });
-    // A bracket in the regular expression keeps pgrep and pkill from matching their own shell.
+    // A bracket in the regular expression keeps pgrep and pkill from matching their own shell, and
+    // the test's folder (in the part's path) from killing another test's render running at once.
     const std::string pattern = "'--samples " + samples.substr(0, 1) + "[" + samples.substr(1, 1) + "]" +
-                                samples.substr(2) + " '";
+                                samples.substr(2) + " -o " + dir_.string() + "/'";
     bool killed = false;
     for (int i = 0; i < 600 && !killed; ++i) {  // up to a minute for the task to start
       if (std::system(("pgrep -f -- " + pattern + " > /dev/null").c_str()) == 0) {
@@ -165,11 +166,11 @@ TEST_F(FarmCli, SlurmRunsTheTasksAsAnArrayAndTheMergeAfterThem) {
   EXPECT_NE(test::readFile(dir_ / "out.farm/tasks.sbatch").find("#SBATCH --array=0-3\n"), std::string::npos);
   EXPECT_NE(test::readFile(dir_ / "out.farm/submit.sh").find("--dependency=afterok:$array"), std::string::npos);
 
-  scene(64, 48, 12000);
+  scene(64, 48, 9000);
   const std::string farm = "farm fog.json --tasks 3 --scheduler slurm -o killed.exr --submit";
-  r = farmKillingTask(farm, "4000:8000", std::chrono::milliseconds(300));
+  r = farmKillingTask(farm, "3000:6000", std::chrono::milliseconds(300));
   EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_NE(r.err.find("narval: farm: task 1 samples [4000, 8000) failed: no output written; its log: " +
+  EXPECT_NE(r.err.find("narval: farm: task 1 samples [3000, 6000) failed: no output written; its log: " +
                        file("killed.farm/logs/task_1.log")),
             std::string::npos)
       << r.err;
