@@ -26,11 +26,12 @@ while [ $# -gt 0 ]; do
 done
 source bench/bench_common.sh
 bench_init
+chmod a+x "$work"  # munged wants every folder above its socket traversable
 bash tests/farm/slurm_cluster.sh start "$work/cluster" >/dev/null
 trap 'bash tests/farm/slurm_cluster.sh stop "$work/cluster" >/dev/null 2>&1; rm -rf "$work"' EXIT
 export SLURM_CONF=$work/cluster/etc/slurm.conf
 
-"$narval" render "$scene" --resolution "$resolution" --spp "$spp" -o "$work/warm.exr" -q  # program into the cache
+"$narval" render "$scene" --resolution "$resolution" --spp 1 -o "$work/warm.exr" -q  # program into the cache
 start=$(date +%s.%N)
 "$narval" render "$scene" --resolution "$resolution" --spp "$spp" -o "$work/plain.exr" -q \
   --stats-json "$work/plain.json"
