@@ -113,7 +113,7 @@ RenderResult collectedRender(const Scene& s, const fs::path& exr) {
     throw inputError(exr.string(), "narval:render_key",
                      "not a path-traced render of " + s.sourcePath + " at " + std::to_string(s.renderer.spp) + " spp and " +
                          std::to_string(s.renderer.bounces) + " bounces; run the sweep's farm task for it again");
-  const RenderPart part = readRenderPart(exr.string());
+  const RenderPart part = readRenderPartHeader(exr.string());
   RenderResult r;
   r.image = readExr(exr.string());
   RenderStats& st = r.stats;

@@ -153,14 +153,10 @@ void writeExr(const std::string& path, const ImageRGB& image, const std::vector<
 
 namespace {
 
-// Reads the channels `names` (each must exist; with UINT, each must be stored as UINT) into `out`,
-// interleaved (names.size() values per pixel, in that order); *width and *height are the data
-// window's size. T is float (FLOAT, other types converted) or uint32_t (UINT, as stored).
-template <typename T>
-void readChannels(const std::string& path, Imf::InputFile& file, const std::vector<std::string>& names,
-                  std::vector<T>& out, int* width, int* height) {
-  constexpr Imf::PixelType type = std::is_same_v<T, float> ? Imf::FLOAT : Imf::UINT;
-  const Imf::Header& header = file.header();
+// The data window of `header`, checked (not empty, not too large); every channel in `names` must
+// exist, and with `type` UINT be stored as UINT (other types convert to FLOAT as they are read).
+Imath::Box2i checkedWindow(const std::string& path, const Imf::Header& header, const std::vector<std::string>& names,
+                           Imf::PixelType type) {
   for (const std::string& name : names) {
     const Imf::Channel* channel = header.channels().findChannel(name);
     if (channel && type == Imf::UINT && channel->type != Imf::UINT)
@@ -178,17 +174,26 @@ void readChannels(const std::string& path, Imf::InputFile& file, const std::vect
   if (w <= 0 || h <= 0) throw inputError(path, "", "empty data window");
   if (w * h > (int64_t(1) << 28))
     throw inputError(path, "", "image too large (" + std::to_string(w) + "x" + std::to_string(h) + ")");
-  *width = int(w);
-  *height = int(h);
+  return window;
+}
+
+// Slices for the channels `names` into `out`, interleaved (names.size() values per pixel, in that
+// order), sized for `window`. T is float (FLOAT) or uint32_t (UINT).
+template <typename T>
+void addSlices(Imf::FrameBuffer& frame, const Imath::Box2i& window, const std::vector<std::string>& names,
+               std::vector<T>& out) {
+  constexpr Imf::PixelType type = std::is_same_v<T, float> ? Imf::FLOAT : Imf::UINT;
+  const size_t w = size_t(window.max.x - window.min.x + 1), h = size_t(window.max.y - window.min.y + 1);
   const size_t stride = names.size();
-  out.assign(size_t(w * h) * stride, T(0));
-  const size_t xStride = stride * sizeof(T);
-  const size_t yStride = xStride * size_t(w);
+  out.assign(w * h * stride, T(0));
+  const size_t xStride = stride * sizeof(T), yStride = xStride * w;
   char* base = reinterpret_cast<char*>(out.data());
-  Imf::FrameBuffer frame;
   // Slice::Make offsets the base pointer by the data window origin without overflow.
   for (size_t i = 0; i < names.size(); ++i)
     frame.insert(names[i], Imf::Slice::Make(type, base + i * sizeof(T), window, xStride, yStride));
+}
+
+void readFrame(const std::string& path, Imf::InputFile& file, const Imf::FrameBuffer& frame, const Imath::Box2i& window) {
   try {
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);
@@ -197,24 +202,23 @@ void readChannels(const std::string& path, Imf::InputFile& file, const std::vect
   }
 }
 
-}  // namespace
-
-ImageRGB readExr(const std::string& path) {
-  auto file = openExr(path);
-  ImageRGB image;
-  readChannels(path, *file, {"R", "G", "B"}, image.rgb, &image.width, &image.height);
-  return image;
+// Reads the channels `names` into `out`, interleaved; *width and *height are the data window's size.
+template <typename T>
+void readChannels(const std::string& path, Imf::InputFile& file, const std::vector<std::string>& names,
+                  std::vector<T>& out, int* width, int* height) {
+  const Imath::Box2i window =
+      checkedWindow(path, file.header(), names, std::is_same_v<T, float> ? Imf::FLOAT : Imf::UINT);
+  *width = window.max.x - window.min.x + 1;
+  *height = window.max.y - window.min.y + 1;
+  Imf::FrameBuffer frame;
+  addSlices(frame, window, names, out);
+  readFrame(path, file, frame, window);
 }
 
-namespace {
-// The named channels of `path`, one Channel (ExrChannel or ExrUintChannel) each.
-template <typename Channel>
-std::vector<Channel> readNamedChannels(const std::string& path, const std::vector<std::string>& names) {
-  auto file = openExr(path);
-  std::vector<typename decltype(Channel::values)::value_type> interleaved;
-  int width = 0, height = 0;
-  readChannels(path, *file, names, interleaved, &width, &height);
-  const size_t pixels = size_t(width) * size_t(height), n = names.size();
+// Interleaved values (n per pixel) as one channel each.
+template <typename Channel, typename T>
+std::vector<Channel> deinterleave(const std::vector<std::string>& names, const std::vector<T>& interleaved) {
+  const size_t n = names.size(), pixels = n ? interleaved.size() / n : 0;
   std::vector<Channel> channels(n);
   for (size_t c = 0; c < n; ++c) {
     channels[c].name = names[c];
@@ -223,20 +227,10 @@ std::vector<Channel> readNamedChannels(const std::string& path, const std::vecto
   }
   return channels;
 }
-}  // namespace
 
-std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names) {
-  return readNamedChannels<ExrChannel>(path, names);
-}
-
-std::vector<ExrUintChannel> readExrUintChannels(const std::string& path, const std::vector<std::string>& names) {
-  return readNamedChannels<ExrUintChannel>(path, names);
-}
-
-std::map<std::string, std::string> readExrAttributes(const std::string& path) {
-  auto file = openExr(path);
+// The attributes writeExr can write, as text (readExrAttributes).
+std::map<std::string, std::string> attributesOf(const Imf::Header& header) {
   std::map<std::string, std::string> result;
-  const Imf::Header& header = file->header();
   auto shortest = [](double v, int maxDigits) {  // the fewest digits that read back
     char buf[40];
     for (int digits = 1; digits <= maxDigits; ++digits) {
@@ -262,6 +256,65 @@ std::map<std::string, std::string> readExrAttributes(const std::string& path) {
     }
   }
   return result;
+}
+
+}  // namespace
+
+ImageRGB readExr(const std::string& path) {
+  auto file = openExr(path);
+  ImageRGB image;
+  readChannels(path, *file, {"R", "G", "B"}, image.rgb, &image.width, &image.height);
+  return image;
+}
+
+namespace {
+// The named channels of `path`, one Channel (ExrChannel or ExrUintChannel) each.
+template <typename Channel>
+std::vector<Channel> readNamedChannels(const std::string& path, const std::vector<std::string>& names) {
+  auto file = openExr(path);
+  std::vector<typename decltype(Channel::values)::value_type> interleaved;
+  int width = 0, height = 0;
+  readChannels(path, *file, names, interleaved, &width, &height);
+  return deinterleave<Channel>(names, interleaved);
+}
+}  // namespace
+
+std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names) {
+  return readNamedChannels<ExrChannel>(path, names);
+}
+
+std::vector<ExrUintChannel> readExrUintChannels(const std::string& path, const std::vector<std::string>& names) {
+  return readNamedChannels<ExrUintChannel>(path, names);
+}
+
+ExrContents readExrWithUintChannels(const std::string& path, const std::vector<std::string>& uintNames) {
+  auto file = openExr(path);
+  const Imf::Header& header = file->header();
+  const std::vector<std::string> rgb = {"R", "G", "B"};
+  const Imath::Box2i window = checkedWindow(path, header, rgb, Imf::FLOAT);
+  checkedWindow(path, header, uintNames, Imf::UINT);
+  ExrContents c;
+  c.attributes = attributesOf(header);
+  c.image.width = window.max.x - window.min.x + 1;
+  c.image.height = window.max.y - window.min.y + 1;
+  std::vector<uint32_t> uints;
+  Imf::FrameBuffer frame;
+  addSlices(frame, window, rgb, c.image.rgb);
+  addSlices(frame, window, uintNames, uints);
+  readFrame(path, *file, frame, window);
+  c.uints = deinterleave<ExrUintChannel>(uintNames, uints);
+  return c;
+}
+
+std::map<std::string, std::string> readExrAttributes(const std::string& path) {
+  auto file = openExr(path);
+  return attributesOf(file->header());
+}
+
+ExrHeader readExrHeader(const std::string& path) {
+  auto file = openExr(path);
+  const Imath::Box2i window = checkedWindow(path, file->header(), {}, Imf::FLOAT);
+  return {window.max.x - window.min.x + 1, window.max.y - window.min.y + 1, attributesOf(file->header())};
 }
 
 }  // namespace narval

@@ -55,6 +55,21 @@ std::map<std::string, std::string> readExrAttributes(const std::string& path);
 // The named channels as 32-bit float, width*height values each in the data window's size; a
 // missing channel throws InputError "PATH: no NAME channel (channels: ...)", like readExr.
 std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names);
+// The data window's size and the attributes (as readExrAttributes), from the header alone.
+struct ExrHeader {
+  int width = 0, height = 0;
+  std::map<std::string, std::string> attributes;
+};
+ExrHeader readExrHeader(const std::string& path);
+// R, G and B (as readExr), the named UINT channels (as readExrUintChannels) and the attributes (as
+// readExrAttributes) from one opening of the file and one read of its pixels: what `narval merge`
+// reads of each part.
+struct ExrContents {
+  ImageRGB image;
+  std::vector<ExrUintChannel> uints;
+  std::map<std::string, std::string> attributes;
+};
+ExrContents readExrWithUintChannels(const std::string& path, const std::vector<std::string>& uintNames);
 // The named channels as stored, bit for bit: each must be a UINT channel, else InputError "PATH: NAME:
 // not a UINT channel"; a missing one throws like readExrChannels.
 std::vector<ExrUintChannel> readExrUintChannels(const std::string& path, const std::vector<std::string>& names);

@@ -142,10 +142,13 @@ const std::string& RenderPart::attribute(const std::string& name) const {
   return it == attributes.end() ? none : it->second;
 }
 
-RenderPart readRenderPart(const std::string& path) {
+RenderPart readRenderPartHeader(const std::string& path) {
   RenderPart part;
   part.path = path;
-  part.attributes = readExrAttributes(path);
+  ExrHeader header = readExrHeader(path);
+  part.width = header.width;
+  part.height = header.height;
+  part.attributes = std::move(header.attributes);
   const auto& attrs = part.attributes;
   const auto algorithm = attrs.find("narval:algorithm");
   if (algorithm == attrs.end() || algorithm->second != "pathtrace")
@@ -168,11 +171,17 @@ RenderPart readRenderPart(const std::string& path) {
   acc.begin = int(begin);
   acc.samples = int(spp);
   acc.status = uint32_t(attributeNumber(attrs, path, "narval:status"));
-  const ImageRGB image = readExr(path);
-  part.width = image.width;
-  part.height = image.height;
-  const std::vector<ExrUintChannel> channels = readExrUintChannels(path, accumulatorChannelNames());
+  return part;
+}
+
+void loadAccumulatorWords(RenderPart& part) {
+  // The pixels and the accumulator in one read.
+  const ExrContents contents = readExrWithUintChannels(part.path, accumulatorChannelNames());
+  if (contents.image.width != part.width || contents.image.height != part.height)  // changed since the header was read
+    throw inputError(part.path, "", "the file changed while it was read");
+  const std::vector<ExrUintChannel>& channels = contents.uints;
   const size_t pixels = size_t(part.width) * size_t(part.height);
+  AccumulatorState& acc = part.accumulator;
   acc.words.assign(pixels * kAccumulatorWords, 0);
   for (size_t c = 0; c < channels.size(); ++c) {
     size_t word;
@@ -180,6 +189,11 @@ RenderPart readRenderPart(const std::string& path) {
     accumulatorChannelWord(c, &word, &shift);
     for (size_t i = 0; i < pixels; ++i) acc.words[i * kAccumulatorWords + word] |= uint64_t(channels[c].values[i]) << shift;
   }
+}
+
+RenderPart readRenderPart(const std::string& path) {
+  RenderPart part = readRenderPartHeader(path);
+  loadAccumulatorWords(part);
   return part;
 }
 
@@ -187,7 +201,7 @@ bool renderCovers(const std::string& path, const std::string& renderKey, int beg
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return false;
   try {
-    const RenderPart p = readRenderPart(path);
+    const RenderPart p = readRenderPartHeader(path);  // writes are atomic: a file there is whole
     return p.attribute("narval:render_key") == renderKey && p.accumulator.begin == begin && p.accumulator.end() == end;
   } catch (const std::exception&) {
     return false;  // unreadable, or not a path-traced render with its samples

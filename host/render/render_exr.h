@@ -64,9 +64,13 @@ struct RenderPart {
 // Reads a path-traced narval render with its accumulator. InputError "PATH: ATTRIBUTE: ..." when
 // it is not one (another algorithm, no sample range: a render older than exact accumulation).
 RenderPart readRenderPart(const std::string& path);
+// The same from the header alone: accumulator.words stays empty (`narval merge` checks every part
+// this way, then loads their sums one at a time with loadAccumulatorWords).
+RenderPart readRenderPartHeader(const std::string& path);
+void loadAccumulatorWords(RenderPart& part);
 
-// Whether `path` is a readable path-traced render with this render key and samples [begin, end):
-// what a farm task must have left (a part, or one of a sweep's renders).
+// Whether `path` is a path-traced render with this render key and samples [begin, end), by its
+// header: what a farm task must have left (a part, or one of a sweep's renders).
 bool renderCovers(const std::string& path, const std::string& renderKey, int begin, int end);
 
 // Reads the accumulator of an earlier path-traced render of the same scene from `path` for

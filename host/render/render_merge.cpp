@@ -44,8 +44,10 @@ RenderIdentity mergedIdentity(const RenderPart& first, int spp) {
 
 MergedRender mergeRenderParts(const std::vector<std::string>& paths) {
   if (paths.empty()) throw inputError("merge", "", "no parts given");
+  // Every header is checked before any pixel is read; then the sums are added one part at a time,
+  // so a merge of K parts holds two accumulators, not K.
   std::vector<RenderPart> parts;
-  for (const std::string& p : paths) parts.push_back(readRenderPart(p));
+  for (const std::string& p : paths) parts.push_back(readRenderPartHeader(p));
   const RenderPart& first = parts.front();
   for (const RenderPart& p : parts) {
     for (const std::string& key : kPartIdentityAttributes)
@@ -82,12 +84,13 @@ MergedRender mergeRenderParts(const std::vector<std::string>& paths) {
 
   MergedRender merged;
   RenderResult& r = merged.result;
-  r.accumulator = order.front()->accumulator;
   RenderStats& st = r.stats;
-  st.seconds = std::strtod(order.front()->attribute("narval:seconds").c_str(), nullptr);
-  for (size_t i = 1; i < order.size(); ++i) {
-    addAccumulator(r.accumulator, order[i]->accumulator);
-    st.seconds += std::strtod(order[i]->attribute("narval:seconds").c_str(), nullptr);
+  for (size_t i = 0; i < order.size(); ++i) {
+    RenderPart part = *order[i];
+    loadAccumulatorWords(part);
+    if (i == 0) r.accumulator = std::move(part.accumulator);
+    else addAccumulator(r.accumulator, part.accumulator);
+    st.seconds += std::strtod(part.attribute("narval:seconds").c_str(), nullptr);
   }
   st.algorithm = "pathtrace";
   st.device = first.attribute("narval:device");
