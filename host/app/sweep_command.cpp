@@ -196,9 +196,8 @@ int runSweepCommand(const SweepArgs& a) {
   checkOutputWritable((dir / "sweep.json").string(), "-o");
 
   if (!a.scheduler.empty()) {  // the renders as farm tasks, then this sweep with --collect
-    const Scheduler scheduler = a.scheduler == "slurm"    ? Scheduler::Slurm
-                                : a.scheduler == "openjd" ? Scheduler::OpenJd
-                                                          : Scheduler::Local;
+    Scheduler scheduler = Scheduler::Local;
+    schedulerFromName(a.scheduler, &scheduler);  // CLI11 checked the name
     const std::string narval = a.narval.empty() ? thisNarvalBinary() : fs::absolute(a.narval).string();
     const fs::path jobDir = fs::absolute(a.jobDir.empty() ? dir / "farm" : fs::path(a.jobDir)).lexically_normal();
     const FarmJob job = sweepFarmJob(a, scene, parameter, values, narval, fs::absolute(dir).lexically_normal(), jobDir);

@@ -20,6 +20,15 @@ const char* schedulerName(Scheduler s) {
   return "?";
 }
 
+bool schedulerFromName(const std::string& name, Scheduler* out) {
+  for (Scheduler s : {Scheduler::Slurm, Scheduler::OpenJd, Scheduler::Local})
+    if (name == schedulerName(s)) {
+      *out = s;
+      return true;
+    }
+  return false;
+}
+
 std::string FarmJob::logPath(int task) const { return jobDir + "/logs/task_" + std::to_string(task) + ".log"; }
 std::string FarmJob::timePath(int task) const { return jobDir + "/logs/task_" + std::to_string(task) + ".time"; }
 std::string FarmJob::finalLogPath() const { return jobDir + "/logs/final.log"; }

@@ -17,6 +17,7 @@ namespace narval {
 
 enum class Scheduler { Slurm, OpenJd, Local };
 const char* schedulerName(Scheduler s);  // "slurm", "openjd", "local"
+bool schedulerFromName(const std::string& name, Scheduler* out);  // false for another name
 
 struct FarmTask {
   std::vector<std::string> argv;  // the command it runs (the narval binary first)
