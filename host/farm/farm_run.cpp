@@ -106,16 +106,16 @@ FarmOutcome runFarm(const FarmJob& job, Scheduler scheduler, int parallel,
                     const std::function<void(const std::string&)>& say) {
   const auto t0 = std::chrono::steady_clock::now();
   fs::create_directories(job.jobDir + "/logs");
-  const std::vector<int> todo = missingTasks(job);
+  const std::vector<int> toRun = missingTasks(job);
   std::vector<bool> reused(job.tasks.size(), true);
-  for (int t : todo) reused[size_t(t)] = false;
+  for (int t : toRun) reused[size_t(t)] = false;
   FarmOutcome o;
   const int count = int(job.tasks.size());
-  if (int(todo.size()) < count)
-    say(std::to_string(count - int(todo.size())) + " of " + std::to_string(count) +
-        " tasks already have their output; running the other " + std::to_string(todo.size()));
+  if (int(toRun.size()) < count)
+    say(std::to_string(count - int(toRun.size())) + " of " + std::to_string(count) +
+        " tasks already have their output; running the other " + std::to_string(toRun.size()));
   fs::remove(job.finalTimePath());
-  for (int t : todo) fs::remove(job.timePath(t));
+  for (int t : toRun) fs::remove(job.timePath(t));
   // The output counts as merged only when this run wrote it (an older one may be there).
   std::error_code ec;
   const auto outputTime = fs::last_write_time(job.finalOutput, ec);
@@ -123,14 +123,14 @@ FarmOutcome runFarm(const FarmJob& job, Scheduler scheduler, int parallel,
   double openJdFinalSeconds = -1;
   switch (scheduler) {
     case Scheduler::Local:
-      if (!todo.empty()) runLocalTasks(job, todo, parallel, say);
+      if (!toRun.empty()) runLocalTasks(job, toRun, parallel, say);
       if (missingTasks(job).empty()) runLocalFinal(job);
       break;
     case Scheduler::Slurm:
-      o.schedulerIds = submitSlurm(job, todo);
+      o.schedulerIds = submitSlurm(job, toRun);
       break;
     case Scheduler::OpenJd:
-      openJdFinalSeconds = runOpenJd(job, todo);
+      openJdFinalSeconds = runOpenJd(job, toRun);
       break;
   }
   const std::vector<int> missing = missingTasks(job);
