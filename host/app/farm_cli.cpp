@@ -17,7 +17,7 @@ namespace {
 
 std::string seconds(double s) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, s >= 100 ? "%.0f s" : "%.3g s", s);
+  std::snprintf(buf, sizeof buf, s >= 100 ? "%.1f s" : "%.3g s", s);
   return buf;
 }
 
