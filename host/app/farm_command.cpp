@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "app/cli_common.h"
 #include "app/commands.h"
@@ -22,6 +23,7 @@ struct FarmArgs {
   std::string scene, out, scheduler, jobDir, narval, resolution, device, majorant;
   int spp = -1, tasks = 0, parallel = 1, bounces = -1, majorantResolution = -1, threads = 0;
   long long seed = -1;
+  double checkpointSeconds = 0;
   bool submit = false;
   std::vector<std::string> sets;
 };
@@ -37,6 +39,11 @@ std::vector<std::string> renderArgs(const FarmArgs& a) {
   if (!a.majorant.empty()) v.insert(v.end(), {"--majorant", a.majorant});
   if (a.majorantResolution >= 0) v.insert(v.end(), {"--majorant-resolution", std::to_string(a.majorantResolution)});
   if (a.threads > 0) v.insert(v.end(), {"--threads", std::to_string(a.threads)});
+  if (a.checkpointSeconds > 0) {
+    std::ostringstream seconds;
+    seconds << a.checkpointSeconds;
+    v.insert(v.end(), {"--write-partial-images", seconds.str()});
+  }
   return v;
 }
 
@@ -121,6 +128,10 @@ Command addFarmCommand(CLI::App& app) {
   sub->add_option("--majorant-resolution", a->majorantResolution, "Majorant grid cells (0: automatic)")
       ->check(atLeast(0));
   sub->add_option("--threads", a->threads, "PoCL worker threads of every task (CPU devices)")->check(atLeast(1));
+  sub->add_option("--checkpoint", a->checkpointSeconds,
+                  "Every SECONDS, each task writes its part so far (render --write-partial-images): a task killed "
+                  "or preempted then continues from there when the job runs again")
+      ->check(greaterThanZero());
   return {sub, [a]() { return runFarmCommand(*a); }};
 }
 

@@ -51,7 +51,8 @@ FarmJob renderFarmJob(const std::string& narval, const std::string& scene, const
     t.label = "samples [" + std::to_string(a) + ", " + std::to_string(b) + ")";
     t.argv = {narval, "render", scene};
     t.argv.insert(t.argv.end(), renderArgs.begin(), renderArgs.end());
-    t.argv.insert(t.argv.end(), {"--samples", std::to_string(a) + ":" + std::to_string(b), "-o", t.output, "--quiet"});
+    t.argv.insert(t.argv.end(),
+                  {"--samples", std::to_string(a) + ":" + std::to_string(b), "-o", t.output, "--resume", "--quiet"});
     job.tasks.push_back(t);
   }
   job.finalOutput = output;
@@ -62,6 +63,15 @@ FarmJob renderFarmJob(const std::string& narval, const std::string& scene, const
     return renderCovers(tasks[size_t(i)].output, renderKey, ranges[size_t(i)].first, ranges[size_t(i)].second);
   };
   job.finalDone = [output, renderKey, spp] { return renderCovers(output, renderKey, 0, spp); };
+  job.taskResumable = [tasks = job.tasks, ranges, renderKey](int i) {
+    try {
+      const RenderPart p = readRenderPartHeader(tasks[size_t(i)].output);
+      return p.attribute("narval:render_key") == renderKey && p.accumulator.begin == ranges[size_t(i)].first &&
+             p.accumulator.end() <= ranges[size_t(i)].second;
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
   job.openJd = [=] {
     using nlohmann::json;
     OpenJdForm f;
@@ -81,7 +91,7 @@ FarmJob renderFarmJob(const std::string& narval, const std::string& scene, const
     f.taskArgs = {"render", "{{Param.Scene}}"};
     for (const std::string& a : renderArgs) f.taskArgs.push_back(a);
     for (const char* a : {"--samples", "{{Task.Param.Samples}}", "-o", "{{Param.PartsDir}}/part_{{Task.Param.Part}}.exr",
-                          "--quiet"})
+                          "--resume", "--quiet"})
       f.taskArgs.push_back(a);
     f.finalArgs = {"merge"};
     for (int i = 0; i < tasks; ++i) f.finalArgs.push_back("{{Param.PartsDir}}/part_" + std::to_string(i) + ".exr");

@@ -49,6 +49,10 @@ struct FarmJob {
   // output makes it run again); whether the final output is this job's.
   std::function<bool(int task)> taskDone;
   std::function<bool()> finalDone;
+  // Whether task i's output, not done, may stay for the task to continue (a render part with the
+  // task's key and first sample, fewer samples: the task resumes it); null: never. runFarm removes
+  // any other output before the task runs again.
+  std::function<bool(int task)> taskResumable;
   std::function<OpenJdForm()> openJd;  // null: the generic template
 
   std::string logPath(int task) const;   // JOB/logs/task_I.log
@@ -60,7 +64,9 @@ struct FarmJob {
 // A path-traced render of `scene` (absolute) with `renderArgs` (render's flags: --set, --seed, ...),
 // `spp` samples split into `tasks` ranges [iN/K, (i+1)N/K) (contiguous, uneven by at most one
 // sample), parts in JOB/parts/part_I.exr, merged into `output`; `renderKey` is the scene's with
-// those flags (render_exr.h), what a finished part must carry.
+// those flags (render_exr.h), what a finished part must carry. Every task renders with --resume,
+// so a part left by an interrupted task (Ctrl-C, or --write-partial-images in `renderArgs` before
+// a kill) is continued rather than started again.
 FarmJob renderFarmJob(const std::string& narval, const std::string& scene, const std::vector<std::string>& renderArgs,
                       int spp, int tasks, const std::string& jobDir, const std::string& output,
                       const std::string& renderKey, const std::string& name);

@@ -115,7 +115,12 @@ FarmOutcome runFarm(const FarmJob& job, Scheduler scheduler, int parallel,
     say(std::to_string(count - int(toRun.size())) + " of " + std::to_string(count) +
         " tasks already have their output; running the other " + std::to_string(toRun.size()));
   fs::remove(job.finalTimePath());
-  for (int t : toRun) fs::remove(job.timePath(t));
+  for (int t : toRun) {
+    fs::remove(job.timePath(t));
+    // What a task left and cannot continue (another render's part, a broken file) goes first.
+    const std::string& out = job.tasks[size_t(t)].output;
+    if (fs::exists(out) && !(job.taskResumable && job.taskResumable(t))) fs::remove(out);
+  }
   // The output counts as merged only when this run wrote it (an older one may be there).
   std::error_code ec;
   const auto outputTime = fs::last_write_time(job.finalOutput, ec);

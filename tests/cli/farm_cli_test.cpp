@@ -50,8 +50,9 @@ class FarmCli : public test::CliFixture {
     test::expectSameBits(file("whole.exr"), file(out));
   }
   // Runs `farm ARGS` in a thread while SIGKILLing the render of `samples` (e.g. "4:8") once it has
-  // run for `after`; the farm's result.
-  RunResult farmKillingTask(const std::string& args, const std::string& samples, std::chrono::milliseconds after) {
+  // run for `after` (and, when `waitFor` names a file, once that file exists); the farm's result.
+  RunResult farmKillingTask(const std::string& args, const std::string& samples, std::chrono::milliseconds after,
+                            const std::string& waitFor = "") {
     auto farm = std::async(std::launch::async, [&] { return run(args); });
     // A bracket in the regular expression keeps pgrep and pkill from matching their own shell, and
     // the test's folder (in the part's path) from killing another test's render running at once.
@@ -61,6 +62,8 @@ class FarmCli : public test::CliFixture {
     for (int i = 0; i < 600 && !killed; ++i) {  // up to a minute for the task to start
       if (std::system(("pgrep -f -- " + pattern + " > /dev/null").c_str()) == 0) {
         std::this_thread::sleep_for(after);
+        for (int k = 0; k < 1200 && !waitFor.empty() && !fs::exists(dir_ / waitFor); ++k)
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
         killed = std::system(("pkill -KILL -f -- " + pattern).c_str()) == 0;
       } else {
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -137,6 +140,32 @@ TEST_F(FarmCli, AKilledTaskIsReportedAndRunningAgainRendersOnlyIt) {
   EXPECT_NE(again.out.find("task 2 samples [8000, 12000): output from an earlier run\n"), std::string::npos);
   EXPECT_NE(again.out.find("task 1 samples [4000, 8000): "), std::string::npos);
   expectWhole("out.exr");
+}
+
+// --checkpoint: a task killed mid-render has left its part so far (samples [4000, 4000 + k)); the
+// same command again continues it (its log says "does not exist yet" once, from the first run
+// only) and the image is the single render's bits. A part of another render in the job folder
+// (another seed) is not continued but rendered again.
+TEST_F(FarmCli, AKilledTaskContinuesFromItsCheckpoint) {
+  scene(64, 48, 12000);
+  const std::string farm = "farm fog.json --tasks 3 --scheduler local -o out.exr --submit --checkpoint 0.2";
+  const RunResult r = farmKillingTask(farm, "4000:8000", std::chrono::milliseconds(300), "out.farm/parts/part_1.exr");
+  EXPECT_EQ(r.code, 1) << r.err;
+  const auto cut = readExrAttributes(file("out.farm/parts/part_1.exr"));
+  EXPECT_EQ(cut.at("narval:sample_begin"), "4000");
+  const int end = std::stoi(cut.at("narval:sample_end"));
+  EXPECT_GT(end, 4000);
+  EXPECT_LT(end, 8000);
+  ASSERT_EQ(run("render fog.json --samples 8000:12000 --seed 9 -o out.farm/parts/part_2.exr -q").code, 0);
+  const RunResult again = run(farm);
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.out.find("farm: 1 of 3 tasks already have their output; running the other 2\n"), std::string::npos)
+      << again.out;
+  expectWhole("out.exr");
+  const std::string log = test::readFile(dir_ / "out.farm/logs/task_1.log");
+  const std::string fresh = "does not exist yet; rendering from the first sample";
+  EXPECT_EQ(log.find(fresh), log.rfind(fresh)) << log;
+  EXPECT_NE(log.find(fresh), std::string::npos) << log;
 }
 
 // A one-node Slurm cluster of this machine: the array tasks and the merge run as Slurm jobs (their
