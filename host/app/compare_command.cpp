@@ -130,7 +130,8 @@ int runCompare(const CompareArgs& a) {
                                       {"mean_dE2000", c.stats2000.mean},
                                       {"p95_dE2000", c.stats2000.p95},
                                       {"max_dE2000", c.stats2000.max},
-                                      {"jnd2000_pct", c.stats2000.jndPercent}};
+                                      {"jnd2000_pct", c.stats2000.jndPercent},
+                                      {"rel_mse", c.relMse}};
     std::cout << j.dump(2) << "\n";
     return 0;
   }
@@ -141,7 +142,8 @@ int runCompare(const CompareArgs& a) {
   char header[160];
   std::snprintf(header, sizeof header, "%-8s %10s %10s %10s %10s\n", "", "mean", "p95", "max", "JND%");
   std::cout << header << tableRow("dE76", c.stats76) << tableRow("dE2000", c.stats2000)
-            << "(p95: the value of rank ceil(0.95 n); JND%: pixels with dE > 2.3)\n";
+            << "(p95: the value of rank ceil(0.95 n); JND%: pixels with dE > 2.3)\n"
+            << "relMSE (linear, before the display transform) " << c.relMse << "\n";
   if (!a.heatmap.empty()) std::cout << "wrote " << a.heatmap << " (dE76, 0 to " << fixed(a.heatmapMax, 2) << ")\n";
   if (!a.jndMap.empty()) std::cout << "wrote " << a.jndMap << " (dE76 > 2.3 in red)\n";
   return 0;

@@ -161,6 +161,12 @@ ImageComparison compareImages(const ImageRGB& reference, const ImageRGB& test, c
   c.dE2000.resize(n);
   const float scale = exposureScale(display.exposureStops);
   const ToneMapping tm = display.toneMapping;
+  double relMseSum = 0;
+  for (size_t k = 0; k < n * 3; ++k) {
+    const double r = reference.rgb[k], d = double(test.rgb[k]) - r;
+    relMseSum += d * d / (r * r + kRelMseEpsilon);
+  }
+  c.relMse = n > 0 ? relMseSum / double(n * 3) : 0.0;
   for (size_t i = 0; i < n; ++i) {
     const float* p = &reference.rgb[i * 3];
     const float* q = &test.rgb[i * 3];

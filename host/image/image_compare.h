@@ -21,7 +21,15 @@ struct ImageComparison {
   int width = 0, height = 0;
   std::vector<float> dE76, dE2000;  // per pixel, row 0 at the top
   DeltaEStats stats76, stats2000;
+  // Relative mean squared error of the linear values (before the display transform), the error
+  // Monte Carlo renderers are raced by (pbrt-v4, Mitsuba 3): the mean over pixels and channels of
+  // (test − ref)² / (ref² + kRelMseEpsilon). It falls as 1/spp for an unbiased renderer, so time ×
+  // relMSE is a renderer's cost at equal error.
+  double relMse = 0;
 };
+
+// The ε that keeps relMSE finite where the reference is black.
+constexpr double kRelMseEpsilon = 1e-2;
 
 struct DisplaySettings {
   float exposureStops = 0.0f;

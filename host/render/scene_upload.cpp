@@ -13,6 +13,7 @@
 
 #include "render/blackbody.h"
 #include "render/kernel_features.h"
+#include "render/light_selection.h"
 #include "scene/input_error.h"
 #include "volume/majorant_grid.h"
 
@@ -292,6 +293,9 @@ DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids) {
   }
   if (ds.emissionTable.empty()) ds.emissionTable.assign(3, 0.0f);
   sp.num_lights = int(ds.lights.size());
+  const PathtraceSettings& pt = scene.renderer.pathtrace;
+  assignLightSelection(ds, pt.lightSampling);
+  sp.shadow_roulette = pt.shadowRoulette;
   if (ds.lights.empty()) ds.lights.push_back(light_params{});  // a buffer may not be empty
   try {
     ds.buildOptions = sceneBuildOptions(ds);  // render/kernel_features.h

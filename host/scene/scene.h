@@ -119,6 +119,18 @@ struct RaymarchSettings {
   int shadowAreaSamples = 4;
 };
 
+// Next-event estimation in the path tracer (kernels/shared/light_select.h): a shadow ray to every
+// light at every scattering event, or to one light picked in proportion to its power or to its
+// estimated fluence over the medium (render/light_selection.h).
+enum class LightSampling { All, Power, Fluence };
+
+struct PathtraceSettings {
+  LightSampling lightSampling = LightSampling::All;
+  // Ratio-tracked shadow rays play Russian roulette once their transmittance is below this in
+  // every channel (kernels/shared/tracking.h); 0 = never.
+  float shadowRoulette = 0.0f;
+};
+
 // The Lobe Estimator: the dissertation's Eq. 7, or the corrected estimator (kernels/shared/lobe.h).
 enum class LobeVariant { Eq7, Corrected };
 
@@ -163,6 +175,7 @@ struct RendererSettings {
   Algorithm algorithm = Algorithm::Pathtrace;
   uint32_t seed = 0;
   GridStorage storage = GridStorage::Auto;
+  PathtraceSettings pathtrace;
   RaymarchSettings raymarch;
   LobeSettings lobe;
   LightCacheSettings lightCache;

@@ -60,6 +60,10 @@
 // |   storage               | auto, image, buffer, bricks:    |     | auto        | auto: buffer on CPU        |
 // |                         | the grid on the device          |     |             | devices, image elsewhere;  |
 // |                         | (--storage)                     |     |             | bricks if those can't hold |
+// |   pathtrace.lightSampling | all, power, fluence: NEE aims  |     | all         |                            |
+// |                         | at every light, or at one       |     |             |                            |
+// |   pathtrace.shadowRoulette | number: shadow-ray Tr below  |     | 0           | [0, 1]; 0 = never          |
+// |                         | which Russian roulette plays    |     |             |                            |
 // |   raymarch.steps        | integer                         |     | 60          | >= 1                       |
 // |   raymarch.shadowSteps  | integer                         |     | 10          | >= 1                       |
 // |   raymarch.octaves      | integer                         |     | 1           | [1, 16]; 1 = off           |
@@ -164,6 +168,8 @@ const EnumNames<GridStorage> kGridStorages = {{"auto", GridStorage::Auto},
 const EnumNames<MultipleScattering> kMultipleScattering = {{"none", MultipleScattering::None},
                                                            {"octaves", MultipleScattering::Octaves},
                                                            {"cache", MultipleScattering::Cache}};
+const EnumNames<LightSampling> kLightSamplings = {
+    {"all", LightSampling::All}, {"power", LightSampling::Power}, {"fluence", LightSampling::Fluence}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
 const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
                                           {"raymarch", Algorithm::Raymarch},
@@ -396,6 +402,12 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
   s.storage = readEnum(r, "storage", kGridStorages, s.storage);
   s.seed = static_cast<uint32_t>(checkIntRange(ctx, r.keyOf("seed"), r.getInteger("seed", s.seed), 0,
                                                std::numeric_limits<uint32_t>::max()));
+  if (const json* v = r.find("pathtrace")) {
+    ObjectReader p(ctx, *v, r.keyOf("pathtrace"));
+    s.pathtrace.lightSampling = readEnum(p, "lightSampling", kLightSamplings, s.pathtrace.lightSampling);
+    s.pathtrace.shadowRoulette = readUnitInterval(p, "shadowRoulette", s.pathtrace.shadowRoulette);
+    p.reportUnknown();
+  }
   if (const json* v = r.find("raymarch")) {
     ObjectReader m(ctx, *v, r.keyOf("raymarch"));
     s.raymarch.steps = readInt(m, "steps", s.raymarch.steps, 1);

@@ -1,8 +1,15 @@
 /* pathtrace.h: one path-traced sample of a pixel (DESIGN.md "pathtrace"; dissertation §4.2-4.3).
  * Free flight by delta/spectral tracking, next-event estimation at every real scattering event
- * (ratio-tracked shadow rays, rectangle lights MIS-combined with phase sampling by the power
- * heuristic, point lights by NEE alone), `max_bounces` real scattering events, escaped rays add the
- * emitter they hit or the background. Rectangles are opaque: their back side is black.
+ * (ratio-tracked shadow rays to every light or to one picked per event (light_select.h), rectangle
+ * lights MIS-combined with phase sampling by the power heuristic, point lights by NEE alone),
+ * Russian roulette on shadow rays as the scene asks (tracking.h), `max_bounces` real scattering
+ * events, escaped rays add the emitter they hit or the background. Rectangles are opaque: their
+ * back side is black.
+ * No Russian roulette on the path's throughput (pbrt-v4's volumetric path tracer has one): here it
+ * could never play. The grey analogue walk keeps β = 1, and spectral tracking keeps the mean of β's
+ * channels at 1 (tracking.h: a real or null event multiplies β by σ_x·c/(σ̄·avg(σ_x ⊙ β)) with
+ * c = σ̄·avg(β)), so β is never below 1 in every channel; absorption already ends paths in
+ * proportion to the energy they lose.
  * Status word: STATUS_NAN for a non-finite sample (written as 0) or a NaN met on the way (density,
  * majorant, phase value: tracking.h and below); STATUS_NEGATIVE_PDF for a phase-sampled direction
  * whose pdf is not positive and for a majorant below σt (tracking.h); STATUS_ITERATION_CAP from the
@@ -16,6 +23,7 @@
 
 #include "shared/camera.h"
 #include "shared/light.h"
+#include "shared/light_select.h"
 #include "shared/medium.h"
 #include "shared/phase.h"
 #include "shared/tracking.h"
@@ -33,32 +41,51 @@ static inline vec3 pathtrace_shadow(KERNEL_CONTEXT_PARAM, int light_index, vec3 
     return vec3_splat(0.0f);
   medium_segment seg;
   if (!s->has_medium || !medium_intersect(&s->medium, x, dir, 0.0f, dist, &seg)) return vec3_splat(1.0f);
-  return tracking_ratio(KERNEL_CONTEXT_ARG, seg.o, seg.d, seg.t0, seg.t1, rng);
+  return tracking_ratio(KERNEL_CONTEXT_ARG, seg.o, seg.d, seg.t0, seg.t1, s->shadow_roulette, rng);
 }
 
-/* Direct light at a scattering point x for a path arriving along w_in, summed over all lights. */
+/* Light i's next-event estimate at a scattering point x for a path arriving along w_in, divided by
+ * the probability `prob` of aiming at it (light_select.h). */
+static inline vec3 pathtrace_light(KERNEL_CONTEXT_PARAM, int i, float prob, vec3 x, vec3 w_in,
+                                   NV_PRIVATE rng_state* rng) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
+  const float u1 = rng_uniform(rng), u2 = rng_uniform(rng);
+  light_sample ls;
+  if (!light_sample_point(&lights[i], x, u1, u2, &ls)) return vec3_splat(0.0f);
+  const float f = phase_eval(s->medium.phase, s->medium.g, w_in, ls.dir);
+  if (!(f > 0.0f)) {
+    if (f != f) ctx->status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
+    return vec3_splat(0.0f);
+  }
+  const vec3 tr = pathtrace_shadow(KERNEL_CONTEXT_ARG, i, x, ls.dir, ls.dist, rng);
+  if (vec3_is_zero(tr)) return vec3_splat(0.0f);
+  /* Point light: Le·f·Tr·I/d² / prob. Rectangle: Le·f·Tr/(prob·pdf_light) weighted against phase
+   * sampling, whose pdf is f (sampling is exact). */
+  const float light_pdf = prob * ls.pdf;
+  const float w = light_pdf > 0.0f ? mis_power_heuristic(light_pdf, f) / light_pdf : 1.0f / prob;
+  return vec3_scale(vec3_mul(ls.radiance, tr), f * w);
+}
+
+/* Direct light at a scattering point x for a path arriving along w_in: every light, or one picked
+ * by light_select (scene_params.light_sampling). */
 static inline vec3 pathtrace_direct(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
-  NV_PRIVATE uint* status = &ctx->status;
-  vec3 sum = vec3_splat(0.0f);
-  for (int i = 0; i < s->num_lights; ++i) {
-    const float u1 = rng_uniform(rng), u2 = rng_uniform(rng);
-    light_sample ls;
-    if (!light_sample_point(&lights[i], x, u1, u2, &ls)) continue;
-    const float f = phase_eval(s->medium.phase, s->medium.g, w_in, ls.dir);
-    if (!(f > 0.0f)) {
-      if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
-      continue;
+  switch (s->light_sampling) {
+    case LIGHT_SAMPLING_ALL: {
+      vec3 sum = vec3_splat(0.0f);
+      for (int i = 0; i < s->num_lights; ++i)
+        sum = vec3_add(sum, pathtrace_light(KERNEL_CONTEXT_ARG, i, 1.0f, x, w_in, rng));
+      return sum;
     }
-    const vec3 tr = pathtrace_shadow(KERNEL_CONTEXT_ARG, i, x, ls.dir, ls.dist, rng);
-    if (vec3_is_zero(tr)) continue;
-    /* Point light: Le·f·Tr·I/d². Rectangle: Le·f·Tr/pdf_light weighted against phase sampling,
-     * whose pdf is f (sampling is exact). */
-    const float w = ls.pdf > 0.0f ? mis_power_heuristic(ls.pdf, f) / ls.pdf : 1.0f;
-    sum = vec3_add(sum, vec3_scale(vec3_mul(ls.radiance, tr), f * w));
+    case LIGHT_SAMPLING_ONE: {
+      const int i = light_select(lights, s->num_lights, rng_uniform(rng));
+      if (i < 0) return vec3_splat(0.0f);
+      return pathtrace_light(KERNEL_CONTEXT_ARG, i, lights[i].select_prob, x, w_in, rng);
+    }
+    default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry (scene_kinds.h) */
   }
-  return sum;
 }
 
 /* Radiance arriving at o from the direction −d, by one path: the ray o + t·d, then up to max_bounces
@@ -111,7 +138,8 @@ static inline vec3 pathtrace_radiance(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, int 
       if (front && (unscattered_emitters || depth > 0)) {
         float w = 1.0f;
         if (prev_phase_pdf > 0.0f)
-          w = mis_power_heuristic(prev_phase_pdf, light_pdf_rectangle(&lights[light_hit], d, t_surf));
+          w = mis_power_heuristic(prev_phase_pdf, light_select_prob(s, lights, light_hit) *
+                                                      light_pdf_rectangle(&lights[light_hit], d, t_surf));
         L = vec3_add(L, vec3_scale(vec3_mul(beta, vec3_from4(lights[light_hit].radiance)), w));
       }
     } else {

@@ -1,5 +1,5 @@
 /* scene_kinds.h: every kind the kernels dispatch on by switch, checked once at each kernel's entry.
- * The switches (phase.h, light.h, march.h, emission.h) give an unknown kind no contribution; this check makes it
+ * The switches (phase.h, light.h, march.h, emission.h, pathtrace.h) give an unknown kind no contribution; this check makes it
  * visible: STATUS_UNKNOWN_KIND in the status word, which the host reports. The host validates kinds
  * before it uploads a scene (render/kernel_features.h), so the bit means host and kernels out of
  * step, never bad input. */
@@ -26,6 +26,11 @@ static inline uint scene_kinds_status(NV_CONSTANT const scene_params* s, NV_CONS
         break;
       default: status |= STATUS_UNKNOWN_KIND;
     }
+  }
+  switch (s->light_sampling) {
+    case LIGHT_SAMPLING_ALL:
+    case LIGHT_SAMPLING_ONE: break;
+    default: status |= STATUS_UNKNOWN_KIND;
   }
   for (int i = 0; i < s->num_lights; ++i) {
     switch (lights[i].type) {

@@ -6,6 +6,10 @@
 
 #include "shared/vec3.h"
 
+/* Next-event estimation in the path tracer (scene_params.light_sampling; light_select.h). */
+#define LIGHT_SAMPLING_ALL 0 /* a shadow ray to every light at every scattering event */
+#define LIGHT_SAMPLING_ONE 1 /* one light per event, picked with light_params.select_prob */
+
 /* Light types (light_params.type). */
 #define LIGHT_RECTANGLE 0
 #define LIGHT_POINT 1
@@ -40,7 +44,9 @@ typedef struct camera_params {
 
 /* One emitter. Rectangle: corner + s*edge_u + t*edge_v, s,t in [0,1], emitting along `normal`
  * (one-sided) with radiance `radiance`; normal.w holds the area. Point: `corner` is the position,
- * `radiance` the intensity in W/sr. */
+ * `radiance` the intensity in W/sr. select_prob, select_cdf: the probability that next-event
+ * estimation picks this light when it picks one light per event (light_select.h), and the sum of
+ * the probabilities up to and including this light's. */
 typedef struct light_params {
   nv_float4 corner;
   nv_float4 edge_u;
@@ -48,9 +54,9 @@ typedef struct light_params {
   nv_float4 normal;
   nv_float4 radiance;
   int type;
+  float select_prob;
+  float select_cdf;
   int pad0;
-  int pad1;
-  int pad2;
 } light_params;
 
 /* The coarse majorant grid over the medium's index box (host/volume/majorant_grid.h): cells of
@@ -144,6 +150,10 @@ typedef struct scene_params {
   int num_lights;
   int max_bounces;      /* real scattering events per path */
   uint seed;
+  int light_sampling;   /* path tracer's next-event estimation: LIGHT_SAMPLING_ALL or _ONE (light_select.h) */
+  float shadow_roulette; /* ratio-tracked shadow rays play Russian roulette below this transmittance; 0: never */
+  int pad0;
+  int pad1;
 } scene_params;
 
 #endif

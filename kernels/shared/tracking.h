@@ -267,8 +267,15 @@ static inline int tracking_delta(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, 
   return TRACK_ABSORBED;
 }
 
-/* Ratio-tracking estimate of the transmittance along o + t·d over [t, t_max]. */
-static inline vec3 tracking_ratio(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, float t_max,
+/* Russian roulette on a ratio-tracked transmittance (pbrt-v4's TraceTransmittance): once every
+ * channel is below `below`, the walk ends with probability q = 3/4 and survives with Tr / (1 − q),
+ * so the estimate keeps its expectation, (1 − q)·Tr/(1 − q) = Tr, while a ray that has crossed a
+ * few mean free paths stops paying for density lookups whose product it barely uses. */
+#define TRACKING_ROULETTE_Q 0.75f
+
+/* Ratio-tracking estimate of the transmittance along o + t·d over [t, t_max]; `roulette_below` > 0
+ * plays Russian roulette below that transmittance (above), 0 never. */
+static inline vec3 tracking_ratio(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, float t_max, float roulette_below,
                                   NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const medium_params* m = ctx->medium;
   NV_PRIVATE uint* status = &ctx->status;
@@ -299,6 +306,10 @@ static inline vec3 tracking_ratio(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t,
     }
     tr = vec3_mul(tr, wt);
     if (vec3_is_zero(tr)) return tr;
+    if (nv_fmax(tr.x, nv_fmax(tr.y, tr.z)) < roulette_below) {
+      if (rng_uniform(rng) < TRACKING_ROULETTE_Q) return vec3_splat(0.0f);
+      tr = vec3_scale(tr, 1.0f / (1.0f - TRACKING_ROULETTE_Q));
+    }
   }
   *status |= STATUS_ITERATION_CAP;
   return vec3_splat(0.0f);

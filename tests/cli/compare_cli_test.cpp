@@ -68,6 +68,14 @@ void expectPairJson(const nlohmann::json& j) {
   EXPECT_DOUBLE_EQ(j["jnd2000_pct"].get<double>(), 15.0);
 }
 
+// relMSE of the pair at `scale` (linear values: the display transform does not enter): 12 pixels
+// off by 0.216 − 0.125, 20 by 0.125·0.030301, the other 48 equal, each over ref² + 0.01, all three
+// channels alike, averaged over the 80 pixels.
+double pairRelMse(double scale) {
+  const double ref = 0.125 * scale, far = 0.216 * scale - ref, near = ref * 0.030301, den = ref * ref + 0.01;
+  return (12 * far * far / den + 20 * near * near / den) / 80;
+}
+
 TEST_F(CompareCli, IdenticalImagesGiveZero) {
   ImageRGB im = uniform(9, 7, 0.0f);
   for (size_t i = 0; i < im.rgb.size(); ++i) im.rgb[i] = float(i % 17) / 8.0f;
@@ -82,7 +90,8 @@ TEST_F(CompareCli, IdenticalImagesGiveZero) {
   ASSERT_EQ(j.code, 0) << j.err;
   const nlohmann::json v = nlohmann::json::parse(j.out);
   for (const char* key :
-       {"mean_dE76", "p95_dE76", "max_dE76", "jnd76_pct", "mean_dE2000", "p95_dE2000", "max_dE2000", "jnd2000_pct"})
+       {"mean_dE76", "p95_dE76", "max_dE76", "jnd76_pct", "mean_dE2000", "p95_dE2000", "max_dE2000", "jnd2000_pct",
+        "rel_mse"})
     EXPECT_EQ(v[key].get<double>(), 0.0) << key;
 }
 
@@ -97,7 +106,8 @@ TEST_F(CompareCli, JsonKeysAndValuesOnAConstructedPair) {
   std::sort(keys.begin(), keys.end());
   EXPECT_EQ(keys, (std::vector<std::string>{"display_transform", "exposure", "height", "jnd2000_pct", "jnd76_pct",
                                             "max_dE2000", "max_dE76", "mean_dE2000", "mean_dE76", "p95_dE2000",
-                                            "p95_dE76", "reference", "test", "tonemap", "width"}));
+                                            "p95_dE76", "reference", "rel_mse", "test", "tonemap", "width"}));
+  EXPECT_NEAR(j["rel_mse"].get<double>() / pairRelMse(1.0), 1.0, 1e-5);
   EXPECT_EQ(j["display_transform"], "the default: the EXRs record no common display transform");
   EXPECT_EQ(j["reference"], "ref.exr");
   EXPECT_EQ(j["test"], "test.exr");
@@ -114,6 +124,8 @@ TEST_F(CompareCli, ExposureAndToneMappingApplyToBoth) {
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["exposure"], -2.0);
   expectPairJson(j);
+  // relMSE reads the linear files: 4x the values, the ε of 0.01 now small beside ref² = 0.25.
+  EXPECT_NEAR(j["rel_mse"].get<double>() / pairRelMse(4.0), 1.0, 1e-5);
   // 1.0 against 2.0: equal once clipped, different through Reinhard (1/2 vs 2/3).
   writeImage("one.exr", uniform(3, 3, 1.0f));
   writeImage("two.exr", uniform(3, 3, 2.0f));

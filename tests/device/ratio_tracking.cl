@@ -27,7 +27,7 @@ __kernel void ratio_tracking_stats(__constant medium_params* m, GRID_STORAGE gri
   if (medium_intersect(m, o, d, 0.0f, NV_INFINITY, &seg)) {
     for (uint s = 0u; s < n; ++s) {
       rng_state rng = rng_init(1234u, (uint)i, s);
-      const float tr = tracking_ratio(TEST_ARG(ctx), seg.o, seg.d, seg.t0, seg.t1, &rng).x;
+      const float tr = tracking_ratio(TEST_ARG(ctx), seg.o, seg.d, seg.t0, seg.t1, 0.0f, &rng).x;
       /* Welford's running mean and variance */
       const float delta = tr - mean;
       mean += delta / (float)(s + 1u);

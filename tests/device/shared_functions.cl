@@ -109,7 +109,7 @@ __kernel void sf_tracking_ratio(__constant medium_params* m, __global const floa
   rng_state rng = rng_init(1u, i, 0u);
   kernel_context ctx = kernel_context_of_medium(m, 0); /* homogeneous: one global majorant */
   const vec3 tr = tracking_ratio(&ctx, vec3_make(0.0f, 0.0f, 0.0f), vec3_make(0.0f, 0.0f, 1.0f), in[2 * i],
-                                 in[2 * i + 1], &rng);
+                                 in[2 * i + 1], 0.0f, &rng);
   out[3 * i + 0] = tr.x;
   out[3 * i + 1] = tr.y;
   out[3 * i + 2] = tr.z;

@@ -422,7 +422,7 @@ TEST_F(SharedOnDevice, TrackingRatioHomogeneous) {
     rng_state rng = rng_init(1u, static_cast<uint>(i), 0u);
     uint status = 0u;
     const vec3 tr = tracking_ratio(narval::test::hostContext(&m, &h, &status), vec3_splat(0.0f), vec3_make(0, 0, 1),
-                                   in[2 * i], in[2 * i + 1], &rng);
+                                   in[2 * i], in[2 * i + 1], 0.0f, &rng);
     diff.add(tr.x, dev[3 * i], 0.0f, at(i));
     diff.add(tr.y, dev[3 * i + 1], 0.0f, at(i));
     diff.add(tr.z, dev[3 * i + 2], 0.0f, at(i));

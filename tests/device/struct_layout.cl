@@ -19,8 +19,8 @@
   F(camera_params, lens_radius) F(camera_params, focus_distance) F(camera_params, width)           \
   F(camera_params, height) F(camera_params, pad0) F(camera_params, pad1)                           \
   S(light_params) F(light_params, corner) F(light_params, edge_u) F(light_params, edge_v)          \
-  F(light_params, normal) F(light_params, radiance) F(light_params, type) F(light_params, pad0)    \
-  F(light_params, pad1) F(light_params, pad2)                                                      \
+  F(light_params, normal) F(light_params, radiance) F(light_params, type) F(light_params, select_prob)\
+  F(light_params, select_cdf) F(light_params, pad0)                                                   \
   S(medium_params) F(medium_params, world_to_index) F(medium_params, world_to_index.row[2])        \
   F(medium_params, dims) F(medium_params, sigma_a) F(medium_params, sigma_s)                       \
   F(medium_params, majorant) F(medium_params, g) F(medium_params, phase) F(medium_params, grey)    \
@@ -35,7 +35,8 @@
   S(scene_params) F(scene_params, camera) F(scene_params, camera.height) F(scene_params, medium)    \
   F(scene_params, medium.sigma_s) F(scene_params, medium.grey) F(scene_params, background)         \
   F(scene_params, has_medium) F(scene_params, num_lights) F(scene_params, max_bounces)             \
-  F(scene_params, seed)                                                                            \
+  F(scene_params, seed) F(scene_params, light_sampling) F(scene_params, shadow_roulette)           \
+  F(scene_params, pad0) F(scene_params, pad1)                                                     \
   S(realtime_params) F(realtime_params, steps) F(realtime_params, shadow_steps)                   \
   F(realtime_params, octaves) F(realtime_params, octave_a) F(realtime_params, octave_b)           \
   F(realtime_params, octave_c) F(realtime_params, depth_factor) F(realtime_params, lobe_radius)   \

@@ -38,7 +38,8 @@ std::vector<std::string> schemaScenes(const std::string& vdb) {
           "primitives": [)" + lights + R"(
             {"type": "volume", "materialName": "fog"}],
           "renderer": {"resolution": [8, 8], "algorithm": "raymarch",
-                       "raymarch": {"multipleScattering": "cache", "msCache": {}}, "lightCache": {}},)" + common + "}",
+                       "raymarch": {"multipleScattering": "cache", "msCache": {}}, "lightCache": {},
+                       "pathtrace": {}},)" + common + "}",
       R"({"materials": [
             {"name": "light", "type": "emitter", "albedo": [1, 1, 1]},
             {"name": "fire", "type": "volume", "scattering": [1, 1, 1], "absorption": [1, 1, 1],

@@ -55,7 +55,7 @@ WalkResult ratio(const medium_params& m, const grid_view& g, uint seed = 1u) {
   rng_state rng = rng_init(seed, 2u, 3u);
   WalkResult r;
   r.tr = tracking_ratio(narval::test::hostContext(&m, &g, &r.status), vec3_make(0.5f, 0.5f, 0.0f),
-                        vec3_make(0, 0, 1), 0.0f, 1.0f, &rng);
+                        vec3_make(0, 0, 1), 0.0f, 1.0f, 0.0f, &rng);
   return r;
 }
 

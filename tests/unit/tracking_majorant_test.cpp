@@ -314,7 +314,7 @@ TEST(TrackingMajorantStats, RatioTrackingMatchesQuadrature) {
       track_counters c = {0, 0, 0};
       for (int i = 0; i < n; ++i) {
         rng_state rng = rng_init(29u, uint(i), uint(mode));
-        const vec3 tr = tracking_ratio(narval::test::hostContext(&g.medium, view, &status, &c), r.o, r.d, r.t0, r.t1,
+        const vec3 tr = tracking_ratio(narval::test::hostContext(&g.medium, view, &status, &c), r.o, r.d, r.t0, r.t1, 0.0f,
                                        &rng);
         for (int ch = 0; ch < 3; ++ch) acc[ch].add(channelOf(tr, ch));
       }
@@ -394,7 +394,7 @@ TEST(TrackingMajorantEmptyCells, AWalkThroughEmptyCellsMakesNoLookup) {
               TRACK_ESCAPED);
     EXPECT_EQ(rng.used, 1u);  // one draw of the first Philox block
     const vec3 tr = tracking_ratio(narval::test::hostContext(&g.medium, &g.withCells, &status, &grid), seg.o, seg.d,
-                                   seg.t0, seg.t1, &rng);
+                                   seg.t0, seg.t1, 0.0f, &rng);
     EXPECT_EQ(tr.x, 1.0f);
     EXPECT_EQ(tr.z, 1.0f);
     EXPECT_EQ(rng.used, 2u);
@@ -402,7 +402,7 @@ TEST(TrackingMajorantEmptyCells, AWalkThroughEmptyCellsMakesNoLookup) {
     tracking_delta(narval::test::hostContext(&g.medium, &g.withoutCells, &status, &global), seg.o, seg.d, seg.t0,
                    seg.t1, &rng2, &beta, &t);
     tracking_ratio(narval::test::hostContext(&g.medium, &g.withoutCells, &status, &global), seg.o, seg.d, seg.t0,
-                   seg.t1, &rng2);
+                   seg.t1, 0.0f, &rng2);
   }
   EXPECT_EQ(status, 0u);
   EXPECT_EQ(grid.tentative, 0u);
