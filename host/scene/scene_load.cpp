@@ -62,7 +62,7 @@
 // |                         | (--storage)                     |     |             | bricks if those can't hold |
 // |   pathtrace.lightSampling | all, power, fluence: NEE aims  |     | all         |                            |
 // |                         | at every light, or at one       |     |             |                            |
-// |   pathtrace.shadowRoulette | number: shadow-ray Tr below  |     | 0           | [0, 1]; 0 = never          |
+// |   pathtrace.shadowRoulette | number: shadow-ray Tr below  |     | 0.05        | [0, 1]; 0 = never          |
 // |                         | which Russian roulette plays    |     |             |                            |
 // |   raymarch.steps        | integer                         |     | 60          | >= 1                       |
 // |   raymarch.shadowSteps  | integer                         |     | 10          | >= 1                       |
