@@ -23,23 +23,8 @@ if ! command -v dpkg-query >/dev/null || ! grep -qiE '^(ID|ID_LIKE)=.*(debian|ub
   packages=()
 fi
 
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  sudo=""
-  [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null && sudo -n true 2>/dev/null && sudo="sudo -n"
-  if [ "$(id -u)" -eq 0 ] || [ -n "$sudo" ]; then
-    echo "setup: installing ${missing[*]}"
-    $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -qq
-    $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-  else
-    echo "setup: missing packages; run as root:" >&2
-    echo "  apt-get install -y ${missing[*]}" >&2
-    exit 1
-  fi
-fi
+source scripts/apt_packages.sh
+apt_install_missing setup "${packages[@]}"
 
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null

@@ -20,23 +20,8 @@ here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(cd "$here/../.." && pwd)"
 venv="${NARVAL_MITSUBA_VENV:-$repo/build/mitsuba-venv}"
 
-packages=(python3-venv python3-openvdb libllvm19)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  sudo=""
-  [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null && sudo -n true 2>/dev/null && sudo="sudo -n"
-  if [ "$(id -u)" -eq 0 ] || [ -n "$sudo" ]; then
-    echo "vs_mitsuba setup: installing ${missing[*]}"
-    $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -qq
-    $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-  else
-    echo "vs_mitsuba setup: missing packages; run as root: apt-get install -y ${missing[*]}" >&2
-    exit 1
-  fi
-fi
+source "$repo/scripts/apt_packages.sh"
+apt_install_missing "vs_mitsuba setup" python3-venv python3-openvdb libllvm19
 
 # Debian's interpreter, not a pyenv or conda one: python3-openvdb is built for it.
 py=/usr/bin/python3

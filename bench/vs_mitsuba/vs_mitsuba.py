@@ -30,6 +30,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.dirname(HERE))  # bench/: what the bench scripts share
+from scene_env import expand_environment  # noqa: E402
 DEFAULT_VENV = os.path.join(REPO, "build", "mitsuba-venv")
 DEFAULT_NARVAL = os.path.join(REPO, "build", "narval")
 WORK_DIR = os.path.join(REPO, "build", "vs_mitsuba")
@@ -122,41 +124,6 @@ except ImportError:  # another interpreter: main() re-executes under the venv be
 # narval's scene file: the parts the path tracer uses (host/scene/scene_load.cpp, scene.h)
 # ================================================================================================
 
-def expand_env(text):
-    """${NAME} and ${NAME:-default} (nested in the default), as host/scene/scene_path.cpp does."""
-    out, i = "", 0
-    while i < len(text):
-        if not text.startswith("${", i):
-            out += text[i]
-            i += 1
-            continue
-        depth, j = 1, i + 2
-        while j < len(text) and depth:
-            if text.startswith("${", j):
-                depth, j = depth + 1, j + 2
-                continue
-            if text[j] == "}":
-                depth -= 1
-            j += 1
-        if depth:
-            raise ValueError("unterminated ${ in %r" % text)
-        body = text[i + 2:j - 1]
-        m = re.match(r"[A-Za-z_][A-Za-z0-9_]*", body)
-        name = m.group(0) if m else ""
-        rest = body[len(name):]
-        if not name or (rest and not rest.startswith(":-")):
-            raise ValueError("bad variable reference ${%s}" % body)
-        value = os.environ.get(name, "")
-        if value:
-            out += value
-        elif rest.startswith(":-"):
-            out += expand_env(rest[2:])
-        else:
-            raise ValueError("environment variable %s is not set" % name)
-        i = j
-    return out
-
-
 def vec3(obj, key, default):
     v = obj.get(key, default)
     return [float(x) for x in v]
@@ -231,7 +198,7 @@ def load_narval_scene(path, resolution=None, overrides=()):
             mat["emission"] = m.get("emission")
             mat["path"] = None
             if "path" in m:
-                p = expand_env(m["path"])
+                p = expand_environment(m["path"])
                 mat["path"] = os.path.normpath(p if os.path.isabs(p) else os.path.join(scene_dir, p))
         materials[mat["name"]] = mat
     prims = []
