@@ -963,6 +963,29 @@ def run_check(args):
 
 # ================================================================================================
 
+def display(x):
+    """narval's default display transform (kernels/shared/tonemap.h): Narkowicz's ACES fit, clamped,
+    then the sRGB curve."""
+    import numpy as np
+    x = np.clip(x, 0.0, 1e4)
+    v = np.clip(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0)
+    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(v, 1 / 2.4) - 0.055)
+
+
+def write_picture(compare_dir, out, diff_scale):
+    """narval's mean image, Mitsuba's, and |narval - Mitsuba| x diff_scale (linear, clipped, sRGB)
+    side by side, from a compare run's folder."""
+    import numpy as np
+    narval = np.load(os.path.join(compare_dir, "narval_mean.npy"))
+    mitsuba_img = np.load(os.path.join(compare_dir, "mitsuba_mean.npy"))
+    diff = np.clip(np.abs(narval - mitsuba_img) * diff_scale, 0.0, 1.0)
+    diff = np.where(diff <= 0.0031308, 12.92 * diff, 1.055 * np.power(diff, 1 / 2.4) - 0.055)
+    gap = np.ones((narval.shape[0], 4, 3))
+    panel = np.concatenate([display(narval), gap, display(mitsuba_img), gap, diff], axis=1)
+    pixels = np.ascontiguousarray((np.clip(panel, 0.0, 1.0) * 255 + 0.5).astype(np.uint8))
+    mitsuba().Bitmap(pixels).write(out)
+
+
 def main():
     if hasattr(signal, "SIGPIPE"):
         signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `... | head` ends quietly
@@ -999,12 +1022,21 @@ def main():
     r.add_argument("--out", help="output folder (default build/vs_mitsuba/race_SCENE)")
     sub.add_parser("check", help="the convention check on tiny analytic scenes (exit 77: no Mitsuba environment)",
                    parents=[common], allow_abbrev=False)
+    pic = sub.add_parser("picture", help="a compare run's mean images and their difference as one PNG",
+                         parents=[common], allow_abbrev=False)
+    pic.add_argument("compare_dir", help="a compare output folder (build/vs_mitsuba/compare_SCENE)")
+    pic.add_argument("out", help="the PNG to write")
+    pic.add_argument("--diff-scale", type=float, default=10.0, help="the difference panel shows |narval - Mitsuba| x this")
     args = ap.parse_args()
 
     reason = ensure_environment(args.command)
     if reason:
         print("vs_mitsuba: skipped: " + reason if args.command == "check" else "vs_mitsuba: " + reason)
         return EXIT_SKIP if args.command == "check" else 2
+    if args.command == "picture":
+        write_picture(args.compare_dir, args.out, args.diff_scale)
+        print("wrote %s" % args.out)
+        return 0
     if args.command != "translate" and not os.access(args.narval, os.X_OK):
         print("vs_mitsuba: no narval binary at %s (--narval or $NARVAL_BINARY)" % args.narval, file=sys.stderr)
         return 2
