@@ -963,13 +963,18 @@ def run_check(args):
 
 # ================================================================================================
 
+def srgb(v):
+    """The sRGB transfer function on values in [0, 1] (kernels/shared/tonemap.h)."""
+    import numpy as np
+    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(v, 1 / 2.4) - 0.055)
+
+
 def display(x):
     """narval's default display transform (kernels/shared/tonemap.h): Narkowicz's ACES fit, clamped,
     then the sRGB curve."""
     import numpy as np
     x = np.clip(x, 0.0, 1e4)
-    v = np.clip(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0)
-    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(v, 1 / 2.4) - 0.055)
+    return srgb(np.clip(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0))
 
 
 def write_picture(compare_dir, out, diff_scale):
@@ -978,8 +983,7 @@ def write_picture(compare_dir, out, diff_scale):
     import numpy as np
     narval = np.load(os.path.join(compare_dir, "narval_mean.npy"))
     mitsuba_img = np.load(os.path.join(compare_dir, "mitsuba_mean.npy"))
-    diff = np.clip(np.abs(narval - mitsuba_img) * diff_scale, 0.0, 1.0)
-    diff = np.where(diff <= 0.0031308, 12.92 * diff, 1.055 * np.power(diff, 1 / 2.4) - 0.055)
+    diff = srgb(np.clip(np.abs(narval - mitsuba_img) * diff_scale, 0.0, 1.0))
     gap = np.ones((narval.shape[0], 4, 3))
     panel = np.concatenate([display(narval), gap, display(mitsuba_img), gap, diff], axis=1)
     pixels = np.ascontiguousarray((np.clip(panel, 0.0, 1.0) * 255 + 0.5).astype(np.uint8))
