@@ -118,19 +118,18 @@ std::vector<double> lightSelectionWeights(const DeviceScene& ds, LightSampling m
 void assignLightSelection(DeviceScene& ds, LightSampling mode) {
   const size_t n = size_t(ds.params.num_lights);
   ds.params.light_sampling = mode == LightSampling::All ? LIGHT_SAMPLING_ALL : LIGHT_SAMPLING_ONE;
-  if (n == 0) return;
+  if (mode == LightSampling::All) {
+    for (size_t i = 0; i < n; ++i) ds.lights[i].select_prob = 1.0f;  // each light its own strategy
+    return;
+  }
   const std::vector<double> w = lightSelectionWeights(ds, mode);
   double total = 0;
   for (double x : w) total += x;
   const double uniformShare = mode == LightSampling::Fluence ? kFluenceUniformShare : 0.0;
-  double cdf = 0;
   for (size_t i = 0; i < n; ++i) {
     // No light has a positive weight (all dark, or no medium point sees any): pick uniformly.
     const double share = total > 0 && std::isfinite(total) ? w[i] / total : 1.0 / double(n);
-    const double p = mode == LightSampling::All ? 1.0 : (1 - uniformShare) * share + uniformShare / double(n);
-    cdf += p;
-    ds.lights[i].select_prob = float(p);
-    ds.lights[i].select_cdf = mode == LightSampling::All ? 1.0f : float(cdf);
+    ds.lights[i].select_prob = float((1 - uniformShare) * share + uniformShare / double(n));
   }
 }
 

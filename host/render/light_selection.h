@@ -26,9 +26,9 @@ constexpr double kFluenceUniformShare = 0.1;
 //   depend on it.
 std::vector<double> lightSelectionWeights(const DeviceScene& ds, LightSampling mode);
 
-// Sets ds.params.light_sampling and every light's select_prob and select_cdf for `mode`
-// (lightSelectionWeights, normalised; fluence mixed with the uniform share above). All: every light
-// gets a shadow ray, probabilities 1.
+// Sets ds.params.light_sampling and every light's select_prob for `mode` (lightSelectionWeights,
+// normalised; fluence mixed with the uniform share above). All: every light gets a shadow ray,
+// probabilities 1.
 void assignLightSelection(DeviceScene& ds, LightSampling mode);
 
 }  // namespace narval

@@ -11,13 +11,16 @@
 
 #include "shared/structs.h"
 
-/* The light whose [cdf_{i-1}, cdf_i) holds u; the last light with a positive probability when
- * rounding leaves u at or above the last cdf. -1 when no light has a positive probability. */
+/* The light whose [cdf_{i-1}, cdf_i) holds u, cdf_i = P_0 + … + P_i summed here; the last light with
+ * a positive probability when rounding leaves u at or above the last cdf. -1 when no light has a
+ * positive probability. */
 static inline int light_select(NV_CONSTANT const light_params* lights, int num_lights, float u) {
   int last = -1;
+  float cdf = 0.0f;
   for (int i = 0; i < num_lights; ++i) {
     if (!(lights[i].select_prob > 0.0f)) continue;
-    if (u < lights[i].select_cdf) return i;
+    cdf += lights[i].select_prob;
+    if (u < cdf) return i;
     last = i;
   }
   return last;

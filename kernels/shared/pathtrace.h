@@ -45,11 +45,11 @@ static inline vec3 pathtrace_shadow(KERNEL_CONTEXT_PARAM, int light_index, vec3 
 }
 
 /* Light i's next-event estimate at a scattering point x for a path arriving along w_in, divided by
- * the probability `prob` of aiming at it (light_select.h). */
-static inline vec3 pathtrace_light(KERNEL_CONTEXT_PARAM, int i, float prob, vec3 x, vec3 w_in,
-                                   NV_PRIVATE rng_state* rng) {
+ * the probability of aiming at it (light_select_prob, as the MIS weight of a rectangle hit uses). */
+static inline vec3 pathtrace_light(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 w_in, NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
+  const float prob = light_select_prob(s, lights, i);
   const float u1 = rng_uniform(rng), u2 = rng_uniform(rng);
   light_sample ls;
   if (!light_sample_point(&lights[i], x, u1, u2, &ls)) return vec3_splat(0.0f);
@@ -76,13 +76,13 @@ static inline vec3 pathtrace_direct(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, NV_
     case LIGHT_SAMPLING_ALL: {
       vec3 sum = vec3_splat(0.0f);
       for (int i = 0; i < s->num_lights; ++i)
-        sum = vec3_add(sum, pathtrace_light(KERNEL_CONTEXT_ARG, i, 1.0f, x, w_in, rng));
+        sum = vec3_add(sum, pathtrace_light(KERNEL_CONTEXT_ARG, i, x, w_in, rng));
       return sum;
     }
     case LIGHT_SAMPLING_ONE: {
       const int i = light_select(lights, s->num_lights, rng_uniform(rng));
       if (i < 0) return vec3_splat(0.0f);
-      return pathtrace_light(KERNEL_CONTEXT_ARG, i, lights[i].select_prob, x, w_in, rng);
+      return pathtrace_light(KERNEL_CONTEXT_ARG, i, x, w_in, rng);
     }
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry (scene_kinds.h) */
   }

@@ -44,9 +44,8 @@ typedef struct camera_params {
 
 /* One emitter. Rectangle: corner + s*edge_u + t*edge_v, s,t in [0,1], emitting along `normal`
  * (one-sided) with radiance `radiance`; normal.w holds the area. Point: `corner` is the position,
- * `radiance` the intensity in W/sr. select_prob, select_cdf: the probability that next-event
- * estimation picks this light when it picks one light per event (light_select.h), and the sum of
- * the probabilities up to and including this light's. */
+ * `radiance` the intensity in W/sr. select_prob: the probability that next-event estimation picks
+ * this light when it picks one light per event (light_select.h). */
 typedef struct light_params {
   nv_float4 corner;
   nv_float4 edge_u;
@@ -55,8 +54,8 @@ typedef struct light_params {
   nv_float4 radiance;
   int type;
   float select_prob;
-  float select_cdf;
   int pad0;
+  int pad1;
 } light_params;
 
 /* The coarse majorant grid over the medium's index box (host/volume/majorant_grid.h): cells of

@@ -20,7 +20,7 @@
   F(camera_params, height) F(camera_params, pad0) F(camera_params, pad1)                           \
   S(light_params) F(light_params, corner) F(light_params, edge_u) F(light_params, edge_v)          \
   F(light_params, normal) F(light_params, radiance) F(light_params, type) F(light_params, select_prob)\
-  F(light_params, select_cdf) F(light_params, pad0)                                                   \
+  F(light_params, pad0) F(light_params, pad1)                                                       \
   S(medium_params) F(medium_params, world_to_index) F(medium_params, world_to_index.row[2])        \
   F(medium_params, dims) F(medium_params, sigma_a) F(medium_params, sigma_s)                       \
   F(medium_params, majorant) F(medium_params, g) F(medium_params, phase) F(medium_params, grey)    \
