@@ -104,9 +104,10 @@ FULL_SWEEPS = {
     "raymarch-none": {"steps": [15, 30, 60, 120], "shadowSteps": [5, 10, 20]},
     "raymarch-octaves": {"octaves": [2, 4, 8], "steps": [30, 60, 120]},
     "raymarch-cache": {"msCache.resolution": [8, 16, 32], "msCache.paths": [64, 256, 1024], "steps": [30, 60, 120],
-                       "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2]},
+                       "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2], "areaLightPhase": ["points", "exact"]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
-    "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32]},
+    "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
+                       "areaLightPhase": ["points", "exact"]},
 }
 QUICK_SWEEPS = {
     "pathtrace": {"spp": [1, 16], "bounces": [1, 4]},
@@ -120,8 +121,9 @@ QUICK_SWEEPS = {
 # host/scene/scene_load.cpp); dotted names are nested objects (renderer.raymarch.msCache.resolution).
 REALTIME_DEFAULTS = {
     "raymarch": {"steps": 60, "shadowSteps": 10, "octaves": 1, "msCache.resolution": 16, "msCache.paths": 256,
-                 "shadowAreaSamples": 4, "areaLightSamples": 1},
-    "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24},
+                 "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points"},
+    "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24,
+             "areaLightPhase": "points"},
 }
 
 
@@ -256,7 +258,8 @@ def build_sweeps(quick, methods, overrides):
 
 
 def format_value(value):
-    return str(value) if isinstance(value, int) else "%g" % value
+    """A parameter value as names and tables show it: integers and names as they are, numbers %g."""
+    return str(value) if isinstance(value, (int, str)) else "%g" % value
 
 
 # ---------------------------------------------------------------------------------------------
@@ -503,7 +506,8 @@ def render_arguments(method, parameters):
         return options + ["--spp", parameters["spp"], "--bounces", parameters["bounces"]]
     options += method_settings_arguments(method)
     for name, value in sorted(parameters.items()):
-        options += ["--set", "renderer.%s.%s=%s" % (algorithm, name, format_value(value))]
+        encoded = json.dumps(value) if isinstance(value, str) else format_value(value)
+        options += ["--set", "renderer.%s.%s=%s" % (algorithm, name, encoded)]
     return options
 
 

@@ -13,7 +13,7 @@ __kernel void lobe(KERNEL_SCENE_ARGS,
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
   KERNEL_CONTEXT_BEGIN(ctx);
-  ctx.status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
+  ctx.status = scene_kinds_status(scene, lights) | realtime_kinds_status(params); /* unknown kinds */
   /* float4 and nv_float4 hold the same four floats (structs.h). */
   const vec3 L =
       lobe_pixel(KERNEL_ENTRY_ARG(ctx), params, (__global const nv_float4*)lobe_directions, light_cache, x, y);

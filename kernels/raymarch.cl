@@ -13,7 +13,7 @@ __kernel void raymarch(KERNEL_SCENE_ARGS,
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= scene->camera.width || y >= scene->camera.height) return;
   KERNEL_CONTEXT_BEGIN(ctx);
-  ctx.status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
+  ctx.status = scene_kinds_status(scene, lights) | realtime_kinds_status(params); /* unknown kinds */
   const vec3 L = raymarch_pixel(KERNEL_ENTRY_ARG(ctx), params, light_cache, ms_cache, x, y);
   out[y * scene->camera.width + x] = (float4)(L.x, L.y, L.z, 0.0f);
   if (ctx.status) atomic_or(status_word, ctx.status);

@@ -45,6 +45,10 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   p.view_steps = lobeViewSteps;
   p.area_light_samples = lobe ? r.lobe.areaLightSamples : r.raymarch.areaLightSamples;
   p.shadow_area_samples = lobe ? lobeShadowAreaSamples : r.raymarch.shadowAreaSamples;
+  switch (lobe ? r.lobe.areaLightPhase : r.raymarch.areaLightPhase) {
+    case AreaLightPhase::Points: p.area_light_phase = AREA_LIGHT_POINTS; break;
+    case AreaLightPhase::Exact: p.area_light_phase = AREA_LIGHT_EXACT; break;
+  }
   p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
   if (!lobe && r.raymarch.multipleScattering == MultipleScattering::Cache)
     p.ms_cache = nodeGridLayout(ds, r.raymarch.msCache.resolution);

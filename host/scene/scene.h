@@ -90,6 +90,11 @@ enum class GridStorage { Auto, Image, Buffer, Bricks };
 // the path-traced multiple-scattering cache (kernels/shared/ms_cache.h).
 enum class MultipleScattering { None, Octaves, Cache };
 
+// How the real-time kernels integrate the phase function over a rectangle light
+// (kernels/shared/march.h, march_light_phase): K×K points (areaLightSamples; 1, the centre, is the
+// dissertation's), or exactly over the light's solid angle (kernels/shared/phase_polygon.h).
+enum class AreaLightPhase { Points, Exact };
+
 struct MsCacheSettings {
   int resolution = 16;      // cells on the medium box's longest axis
   int paths = 256;          // paths per node
@@ -116,6 +121,7 @@ struct RaymarchSettings {
   // dissertation's point approximation. Its shadow is averaged over K×K points
   // (march_light_column), which costs only the light cache's build.
   int areaLightSamples = 1;
+  AreaLightPhase areaLightPhase = AreaLightPhase::Points;
   int shadowAreaSamples = 4;
 };
 
@@ -157,6 +163,7 @@ struct LobeSettings {
                                  // (corrected: of its one view march); 0 = the variant's: eq7 24, corrected 16
   float minTransmittance = 1e-3f;  // those transmittances stop below it (lobe.h: error < it · L_b)
   int areaLightSamples = 1;        // as the ray marcher's
+  AreaLightPhase areaLightPhase = AreaLightPhase::Points;  // as the ray marcher's
   int shadowAreaSamples = 0;       // as the ray marcher's; 0 = the variant's: eq7 1, corrected 4
 };
 

@@ -72,6 +72,8 @@
 // |   raymarch.multipleScattering | none, octaves, cache      |     | none        | octaves when octaves > 1   |
 // |   raymarch.areaLightSamples | integer: K×K points per     |     | 1           | [1, 16]; 1 = the centre    |
 // |                         | rectangle light (phase, 1/d²)   |     |             |                            |
+// |   raymarch.areaLightPhase | points, exact: the phase over |     | points      | exact: its solid-angle     |
+// |                         | a rectangle light               |     |             | integral (phase_polygon.h) |
 // |   raymarch.shadowAreaSamples | integer: K×K points per    |     | 4           | [1, 16]; 1 = the centre    |
 // |                         | rectangle light (shadow)        |     |             |                            |
 // |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]                   |
@@ -87,6 +89,7 @@
 // |                         | corrected: the one view march   |     | corrected 16|                            |
 // |   lobe.minTransmittance | number: Tr(x0 -> P_i) stops     |     | 0.001       | [0, 1); 0 = never          |
 // |   lobe.areaLightSamples | integer, as raymarch's          |     | 1           | [1, 16]                    |
+// |   lobe.areaLightPhase   | points, exact: as raymarch's    |     | points      |                            |
 // |   lobe.shadowAreaSamples | integer, as raymarch's         |     | eq7 1,      | [1, 16]                    |
 // |                         |                                 |     | corrected 4 |                            |
 // |   lightCache.resolution | "auto" or integer: cells on the |     | auto        | [0, 1024]; 0 = off (exact  |
@@ -170,6 +173,8 @@ const EnumNames<MultipleScattering> kMultipleScattering = {{"none", MultipleScat
                                                            {"cache", MultipleScattering::Cache}};
 const EnumNames<LightSampling> kLightSamplings = {
     {"all", LightSampling::All}, {"power", LightSampling::Power}, {"fluence", LightSampling::Fluence}};
+const EnumNames<AreaLightPhase> kAreaLightPhases = {{"points", AreaLightPhase::Points},
+                                                     {"exact", AreaLightPhase::Exact}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
 const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
                                           {"raymarch", Algorithm::Raymarch},
@@ -422,6 +427,9 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
                                                 ") or the octaves add energy");
     s.raymarch.minTransmittance = readMinTransmittance(m, s.raymarch.minTransmittance);
     s.raymarch.areaLightSamples = readInt(m, "areaLightSamples", s.raymarch.areaLightSamples, 1, 16);
+    s.raymarch.areaLightPhase = readEnum(m, "areaLightPhase", kAreaLightPhases, s.raymarch.areaLightPhase);
+    if (s.raymarch.areaLightPhase == AreaLightPhase::Exact && m.find("areaLightSamples"))
+      ctx.warn(m.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
     s.raymarch.shadowAreaSamples = readInt(m, "shadowAreaSamples", s.raymarch.shadowAreaSamples, 1, 16);
     s.raymarch.multipleScattering =
         readEnum(m, "multipleScattering", kMultipleScattering,
@@ -454,6 +462,9 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
     if (l.find("viewSteps")) s.lobe.viewSteps = readInt(l, "viewSteps", 1, 1);
     s.lobe.minTransmittance = readMinTransmittance(l, s.lobe.minTransmittance);
     s.lobe.areaLightSamples = readInt(l, "areaLightSamples", s.lobe.areaLightSamples, 1, 16);
+    s.lobe.areaLightPhase = readEnum(l, "areaLightPhase", kAreaLightPhases, s.lobe.areaLightPhase);
+    if (s.lobe.areaLightPhase == AreaLightPhase::Exact && l.find("areaLightSamples"))
+      ctx.warn(l.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
     if (l.find("shadowAreaSamples")) s.lobe.shadowAreaSamples = readInt(l, "shadowAreaSamples", 1, 1, 16);
     l.reportUnknown();
   }

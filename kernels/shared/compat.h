@@ -27,6 +27,7 @@ typedef ulong nv_ulong; /* 64-bit unsigned (counters, tracking.h) */
 #define nv_sin sin
 #define nv_cos cos
 #define nv_tan tan
+#define nv_atan2 atan2
 #define nv_floor floor
 #define nv_isfinite isfinite
 #define nv_pow pow
@@ -62,6 +63,7 @@ static inline vec3 vec3_make(float x, float y, float z) {
 #define nv_sin sinf
 #define nv_cos cosf
 #define nv_tan tanf
+#define nv_atan2 atan2f
 #define nv_floor floorf
 #define nv_isfinite isfinite
 #define nv_pow powf

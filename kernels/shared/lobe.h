@@ -183,9 +183,10 @@ static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
     if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
     const vec3 tr =
         vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, p, light_cache, k, P, to_light, dist));
-    if (p->area_light_samples > 1) { /* rectangles as K×K points (march_light_phase_sum) */
-      *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase_sum(&lights[k], P, m->phase, m->g, d,
-                                                                      p->area_light_samples)));
+    if (p->area_light_samples > 1 || p->area_light_phase != AREA_LIGHT_POINTS) {
+      /* rectangles as K×K points or integrated exactly (march_light_phase) */
+      *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase(&lights[k], P, m->phase, m->g, d, p->area_light_phase,
+                                                                  p->area_light_samples)));
       continue;
     }
     /* w_in: the light's propagation direction, light → P. */

@@ -14,6 +14,7 @@
 #include "shared/majorant.h"
 #include "shared/medium.h"
 #include "shared/phase.h"
+#include "shared/phase_polygon.h"
 
 /* σt at world point o + t·d of a medium segment (index-space origin and direction in `seg`). */
 static inline vec3 march_sigma_t(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg,
@@ -291,6 +292,43 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
       sum += cos_l * phase_eval(phase_kind, g, view_dir, dir) / d2;
     }
   return vec3_scale(Le, l->normal.w * inv_k * inv_k * sum);
+}
+
+/* Light l's unshadowed in-scattering at x per unit σs with the phase integrated exactly over a
+ * rectangle's solid angle, Le·∫_rect p(view_dir·ω) dω (phase_polygon.h): the limit of
+ * march_light_phase_sum as K → ∞, for 32 evaluations of a closed form per rectangle whatever its
+ * size. Why: at g 0.9 HG falls to half its peak within 5°, and Listing 4.1's light (150x100 units, 80
+ * behind the Disney cloud) spans 86°x64° from it: its centre alone paints a bright disc wherever
+ * the view ray points at it (the phase's peak) and misses the rest (on the back-lit Disney cloud,
+ * relMSE 1.77 against the path tracer with the centre, 0.08 exact); K×K points paint K² discs. A point
+ * light is itself, as in march_light_phase_sum. */
+static inline vec3 march_light_phase_integral(NV_CONSTANT const light_params* l, vec3 x, int phase_kind, float g,
+                                              vec3 view_dir) {
+  switch (LIGHT_KIND(l)) {
+    case LIGHT_POINT: return march_light_phase_sum(l, x, phase_kind, g, view_dir, 1);
+    case LIGHT_RECTANGLE: break; /* below */
+    default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
+  }
+  const vec3 c = vec3_from4(l->corner), u = vec3_from4(l->edge_u), v = vec3_from4(l->edge_v);
+  /* One-sided: x must lie on the side the light faces. */
+  if (!(vec3_dot(vec3_sub(x, c), vec3_from4(l->normal)) > 0.0f)) return vec3_splat(0.0f);
+  vec3 dirs[4];
+  dirs[0] = vec3_normalize(vec3_sub(c, x));
+  dirs[1] = vec3_normalize(vec3_sub(vec3_add(c, u), x));
+  dirs[2] = vec3_normalize(vec3_sub(vec3_add(vec3_add(c, u), v), x));
+  dirs[3] = vec3_normalize(vec3_sub(vec3_add(c, v), x));
+  return vec3_scale(vec3_from4(l->radiance), phase_polygon_integral(phase_kind, g, view_dir, dirs, 4));
+}
+
+/* The real-time kernels' phase over a light (realtime_params.area_light_phase): K×K points
+ * (march_light_phase_sum) or the exact integral (march_light_phase_integral). */
+static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, int phase_kind, float g,
+                                     vec3 view_dir, int area_light_phase, int K) {
+  switch (area_light_phase) {
+    case AREA_LIGHT_POINTS: return march_light_phase_sum(l, x, phase_kind, g, view_dir, K);
+    case AREA_LIGHT_EXACT: return march_light_phase_integral(l, x, phase_kind, g, view_dir);
+    default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
+  }
 }
 
 /* Column density from x to light l, ∫ρ ds over shadow_steps midpoint samples: to the light itself

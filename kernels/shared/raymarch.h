@@ -19,8 +19,10 @@
  *   T  ⊙= e^{−σt(x_k)·Δ}                                     S and σt constant over the step)
  * and the pixel is L + T ⊙ L_b (L_b: march_background, what the ray sees with the medium removed).
  * Lights are points (march_light_as_point: a rectangle is a point at its centre with intensity
- * Le·A·max(0, cos θ_light), the approximation DESIGN.md allows here); other emitters do not block
- * shadow rays. μ is the cosine between the light's propagation direction (light → x) and the
+ * Le·A·max(0, cos θ_light), the approximation DESIGN.md allows here) unless area_light_samples
+ * K > 1 (the phase and 1/d² over K×K points of a rectangle) or area_light_phase is AREA_LIGHT_EXACT
+ * (the phase integrated over the rectangle's solid angle, march_light_phase); other emitters do not
+ * block shadow rays. μ is the cosine between the light's propagation direction (light → x) and the
  * scattered one (x → camera, −d): dot(d, direction to the light), as in pathtrace_direct.
  *
  * Octaves: octave i scatters with σs·aⁱ, sees the light through the shadow transmittance with
@@ -91,17 +93,17 @@ static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
     float dist;
     if (!march_light_as_point(&lights[l], x, &dir, &dist, &I)) continue;
     const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, rp, light_cache, l, x, dir, dist);
-    if (rp->area_light_samples > 1) {
-      /* Rectangles as K×K points (march_light_phase_sum), shadowed towards their centre. */
-      const int K = rp->area_light_samples;
-      vec3 lit = vec3_mul(vec3_exp_neg(tau), march_light_phase_sum(&lights[l], x, m->phase, m->g, view_dir, K));
+    if (rp->area_light_samples > 1 || rp->area_light_phase != AREA_LIGHT_POINTS) {
+      /* Rectangles as K×K points or integrated exactly (march_light_phase), one shadow for all. */
+      const int K = rp->area_light_samples, mode = rp->area_light_phase;
+      vec3 lit = vec3_mul(vec3_exp_neg(tau), march_light_phase(&lights[l], x, m->phase, m->g, view_dir, mode, K));
       float ai = 1.0f, bi = 1.0f, ci = 1.0f;
       for (int i = 1; i < rp->octaves; ++i) {
         ai *= rp->octave_a;
         bi *= rp->octave_b;
         ci *= rp->octave_c;
         lit = vec3_add(lit, vec3_scale(vec3_mul(vec3_exp_neg(vec3_scale(tau, bi)),
-                                                march_light_phase_sum(&lights[l], x, m->phase, m->g * ci, view_dir, K)),
+                                                march_light_phase(&lights[l], x, m->phase, m->g * ci, view_dir, mode, K)),
                                        ai));
       }
       sum = vec3_add(sum, lit);

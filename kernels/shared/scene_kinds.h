@@ -42,4 +42,21 @@ static inline uint scene_kinds_status(NV_CONSTANT const scene_params* s, NV_CONS
   return status;
 }
 
+/* The real-time kernels' own kinds (realtime_params): STATUS_UNKNOWN_KIND for a value no switch
+ * knows. The host never uploads one; a kernel built against other headers would. */
+static inline uint realtime_kinds_status(NV_CONSTANT const realtime_params* rp) {
+  uint status = 0u;
+  switch (rp->area_light_phase) {
+    case AREA_LIGHT_POINTS:
+    case AREA_LIGHT_EXACT: break;
+    default: status |= STATUS_UNKNOWN_KIND;
+  }
+  switch (rp->lobe_variant) {
+    case LOBE_EQ7:
+    case LOBE_CORRECTED: break;
+    default: status |= STATUS_UNKNOWN_KIND;
+  }
+  return status;
+}
+
 #endif

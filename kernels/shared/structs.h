@@ -120,6 +120,12 @@ typedef struct node_grid_params {
 #define LOBE_EQ7 0
 #define LOBE_CORRECTED 1
 
+/* How the real-time kernels integrate the phase function over a rectangle light (march_light_phase):
+ * K×K points (K = realtime_params.area_light_samples; 1, the centre, is the dissertation's), or the
+ * exact solid-angle integral (phase_polygon.h). */
+#define AREA_LIGHT_POINTS 0
+#define AREA_LIGHT_EXACT 1
+
 /* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
 typedef struct realtime_params {
   int steps;            /* raymarch: samples over the view ray's segment; lobe: first-hit search samples */
@@ -138,7 +144,8 @@ typedef struct realtime_params {
   node_grid_params ms_cache;    /* raymarch: the multiple-scattering cache (ms_cache.h); nx = 0: off */
   int area_light_samples;   /* K: a rectangle is K×K points for the phase and 1/d² (march_light_phase_sum) */
   int shadow_area_samples;  /* K: a rectangle's shadow averaged over K×K points (march_light_column) */
-  int pad2, pad3;
+  int area_light_phase;     /* AREA_LIGHT_POINTS (area_light_samples) or AREA_LIGHT_EXACT (march_light_phase) */
+  int pad3;
 } realtime_params;
 
 typedef struct scene_params {

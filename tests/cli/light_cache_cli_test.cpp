@@ -90,6 +90,21 @@ TEST_F(LightCacheCli, MovingALightChangesTheImage) {
   EXPECT_GT(differing, int(a.rgb.size()) / 10);
 }
 
+// With the phase integrated exactly, the K×K points of areaLightSamples are not used: one warning
+// line names the key, and the image is the one rendered without it, bit for bit.
+TEST_F(LightCacheCli, ExactAreaLightPhaseIgnoresAreaLightSamplesWithAWarning) {
+  const RunResult a = run("render s.json -o a.exr --set renderer.raymarch.areaLightPhase=\\\"exact\\\"");
+  ASSERT_EQ(a.code, 0) << a.err;
+  EXPECT_EQ(a.err, "");
+  const RunResult b = run("render s.json -o b.exr --set renderer.raymarch.areaLightPhase=\\\"exact\\\" "
+                          "--set renderer.raymarch.areaLightSamples=4");
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_EQ(b.err, "narval: warning: s.json: renderer.raymarch.areaLightSamples: applies to areaLightPhase "
+                   "\"points\"; \"exact\" ignores it\n");
+  const ImageRGB ia = readExr((dir_ / "a.exr").string()), ib = readExr((dir_ / "b.exr").string());
+  EXPECT_EQ(ia.rgb, ib.rgb);
+}
+
 TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
   const struct {
     const char* set;
@@ -117,6 +132,10 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.shadowAreaSamples: must be at least 1, got 0\n"},
       {"renderer.raymarch.areaLightSamples=17",
        "narval: s.json: renderer.raymarch.areaLightSamples: must be at most 16, got 17\n"},
+      {"renderer.raymarch.areaLightPhase=\\\"disc\\\"",
+       "narval: s.json: renderer.raymarch.areaLightPhase: unknown value \"disc\" (allowed: points, exact)\n"},
+      {"renderer.lobe.areaLightPhase=3",
+       "narval: s.json: renderer.lobe.areaLightPhase: expected a string, got number\n"},
       {"renderer.lobe.shadowAreaSamples=0", "narval: s.json: renderer.lobe.shadowAreaSamples: must be at least 1, got 0\n"},
       {"renderer.lobe.variant=\\\"eq8\\\"",
        "narval: s.json: renderer.lobe.variant: unknown value \"eq8\" (allowed: eq7, corrected)\n"},

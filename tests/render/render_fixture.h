@@ -40,9 +40,10 @@ inline RenderResult renderAlgorithm(const Scene& scene, SceneGrids grid = {}) {
 }
 
 // What the hard-case suites render: every algorithm and every real-time option: the ray marcher
-// with octaves, with its multiple-scattering cache ("raymarch+ms-cache": a small one, 4 cells and 8
-// paths per node, so the suites stay fast; every code path of the cache's build and lookup runs;
-// with 2x2 phase points per rectangle light) and the corrected Lobe Estimator.
+// with octaves (and 2x2 phase points per rectangle light), with its multiple-scattering cache
+// ("raymarch+ms-cache": a small one, 4 cells and 8 paths per node, so the suites stay fast; every
+// code path of the cache's build and lookup runs; with the phase integrated exactly over rectangle
+// lights) and the corrected Lobe Estimator (its phase exact as well).
 inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "raymarch+octaves", "raymarch+ms-cache",
                                                  "lobe", "lobe+corrected"};
 
@@ -54,14 +55,16 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGr
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
     scene.renderer.raymarch.msCache.resolution = 4;
     scene.renderer.raymarch.msCache.paths = 8;
-    scene.renderer.raymarch.areaLightSamples = 2;  // and the phase over a rectangle's area
+    scene.renderer.raymarch.areaLightPhase = AreaLightPhase::Exact;  // the phase over a rectangle's solid angle
   } else if (renderer == "raymarch+octaves") {
     scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Octaves;
     scene.renderer.raymarch.octaves = 3;
+    scene.renderer.raymarch.areaLightSamples = 2;  // and the phase at 2x2 points of a rectangle
   } else if (renderer == "lobe+corrected") {
     scene.renderer.algorithm = Algorithm::Lobe;
     scene.renderer.lobe.variant = LobeVariant::Corrected;
+    scene.renderer.lobe.areaLightPhase = AreaLightPhase::Exact;
   } else if (!algorithmFromName(renderer, &scene.renderer.algorithm)) {
     throw std::invalid_argument("renderWith: no renderer called '" + renderer + "'");
   }
