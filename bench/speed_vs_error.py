@@ -104,7 +104,8 @@ FULL_SWEEPS = {
     "raymarch-none": {"steps": [15, 30, 60, 120], "shadowSteps": [5, 10, 20]},
     "raymarch-octaves": {"octaves": [2, 4, 8], "steps": [30, 60, 120]},
     "raymarch-cache": {"msCache.resolution": [8, 16, 32], "msCache.paths": [64, 256, 1024], "steps": [30, 60, 120],
-                       "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2], "areaLightPhase": ["points", "exact"]},
+                       "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2], "areaLightPhase": ["points", "exact"],
+                       "msCache.closure": ["linear", "hg"]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},
@@ -121,7 +122,7 @@ QUICK_SWEEPS = {
 # host/scene/scene_load.cpp); dotted names are nested objects (renderer.raymarch.msCache.resolution).
 REALTIME_DEFAULTS = {
     "raymarch": {"steps": 60, "shadowSteps": 10, "octaves": 1, "msCache.resolution": 16, "msCache.paths": 256,
-                 "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points"},
+                 "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points", "msCache.closure": "linear"},
     "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24,
              "areaLightPhase": "points"},
 }

@@ -52,6 +52,10 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
   if (!lobe && r.raymarch.multipleScattering == MultipleScattering::Cache)
     p.ms_cache = nodeGridLayout(ds, r.raymarch.msCache.resolution);
+  switch (r.raymarch.msCache.closure) {
+    case MsCacheClosure::Linear: p.ms_cache_closure = MS_CACHE_CLOSURE_LINEAR; break;
+    case MsCacheClosure::Hg: p.ms_cache_closure = MS_CACHE_CLOSURE_HG; break;
+  }
   return p;
 }
 

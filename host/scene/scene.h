@@ -95,7 +95,13 @@ enum class MultipleScattering { None, Octaves, Cache };
 // dissertation's), or exactly over the light's solid angle (kernels/shared/phase_polygon.h).
 enum class AreaLightPhase { Points, Exact };
 
+// What the cache's two moments (directional average R, first moment b) say about the
+// in-scattering in a direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear
+// expansion, or the HG lobe with those moments.
+enum class MsCacheClosure { Linear, Hg };
+
 struct MsCacheSettings {
+  MsCacheClosure closure = MsCacheClosure::Linear;
   int resolution = 16;      // cells on the medium box's longest axis
   int paths = 256;          // paths per node
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)

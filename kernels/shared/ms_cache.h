@@ -25,6 +25,19 @@
  * lookup clamps a + g·(b·w_out) at 0 per channel (a truncated expansion can dip below). For an
  * isotropic phase function g = 0 and only R counts.
  *
+ * Closure (ms_cache_closure, realtime_params.ms_cache_closure): what the two moments say about the
+ * in-scattering in a direction. MS_CACHE_CLOSURE_LINEAR is the truncated expansion above,
+ * R·(1 + g·(b/R)·w_out) clamped at 0. It is exact for a field linear in w, but a field concentrated
+ * along its mean direction, as dense clouds at g 0.8–0.9 hold (light scattered forwards a few
+ * times), has |b|/R near its bound 3 and the expansion sends 1 − g·|b|/R ≈ 0 backwards (where
+ * front-lit clouds are seen from) and at most 1 + 3g forwards. MS_CACHE_CLOSURE_HG takes the field
+ * of the same R and b that is an HG lobe about b: L(w) = 4πR·p_HG(μ, w·b̂) with mean cosine
+ * μ = |b|/(3R) (then (3/4π)∫L w dw = 3Rμ·b̂ = b). HG lobes convolve exactly, their Legendre
+ * coefficients multiplying (gˡ·μˡ = (gμ)ˡ), so the in-scattering is again an HG lobe, of g·μ:
+ *   ∫ p_HG(g, w·w_out) L(w) dw = 4πR·p_HG(gμ, b̂·w_out) = R·(1 − k²)/(1 + k² − 2k·b̂·w_out)^{3/2},  k = gμ,
+ * positive in every direction, equal to the linear closure to first order in μ, and R for an
+ * isotropic field (μ = 0). μ is kept below 0.99 (a noisy b can exceed its bound).
+ *
  * Interpolation: R is interpolated geometrically, exp(Σ w_k ln R_k) with the trilinear weights
  * w_k, and the moment per unit R, b/R, linearly. In a dense medium the radiance falls off
  * exponentially with depth (the Disney cloud at density 10 has a mean free path of a tenth of a
@@ -56,11 +69,26 @@
  * pulls its neighbours down continuously instead of to 0 at once). */
 #define MS_CACHE_LOG_FLOOR 1e-4f
 
+/* R·(the closure's factor) towards w_out for the moment per unit R, m = b/R ("Closure"). */
+static inline float ms_cache_closure(int closure, float R, float g, vec3 m, vec3 w_out) {
+  switch (closure) {
+    case MS_CACHE_CLOSURE_LINEAR: return nv_fmax(0.0f, R * (1.0f + g * vec3_dot(m, w_out)));
+    case MS_CACHE_CLOSURE_HG: {
+      const float len = vec3_length(m);
+      if (!(len > 0.0f)) return R;
+      const float k = g * nv_fmin(0.99f, len / 3.0f);
+      const float d = 1.0f + k * k - 2.0f * k * (vec3_dot(m, w_out) / len);
+      return R * (1.0f - k * k) / (d * nv_sqrt(d));
+    }
+    default: return 0.0f; /* unknown: reported at the kernel's entry */
+  }
+}
+
 /* The in-scattered radiance of the rest at index-space point p (inside the box [0, dims]) towards
- * w_out (the propagation direction after scattering), per unit σs: R·(1 + g·(b/R)·w_out) over the
- * cell's eight nodes ("Interpolation"), at least 0. */
+ * w_out (the propagation direction after scattering), per unit σs: R over the cell's eight nodes
+ * ("Interpolation") times the closure's factor for g and b/R ("Closure"). */
 static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache, vec3 dims,
-                                   vec3 p, float g, vec3 w_out) {
+                                   vec3 p, float g, int closure, vec3 w_out) {
   float w[8];
   size_t at[8];
   node_grid_corners(c, node_grid_locate(c, dims, p), MS_CACHE_STRIDE, at, w);
@@ -97,7 +125,7 @@ static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLO
       }
     }
     const float R = nv_fmax(nv_exp(log_r) - floor, 0.0f);
-    out[ch] = g != 0.0f ? nv_fmax(0.0f, R * (1.0f + g * vec3_dot(ratio, w_out))) : R;
+    out[ch] = g != 0.0f ? ms_cache_closure(closure, R, g, ratio, w_out) : R;
   }
   return vec3_make(out[0], out[1], out[2]);
 }

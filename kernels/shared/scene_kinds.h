@@ -51,6 +51,11 @@ static inline uint realtime_kinds_status(NV_CONSTANT const realtime_params* rp) 
     case AREA_LIGHT_EXACT: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
+  switch (rp->ms_cache_closure) {
+    case MS_CACHE_CLOSURE_LINEAR:
+    case MS_CACHE_CLOSURE_HG: break;
+    default: status |= STATUS_UNKNOWN_KIND;
+  }
   switch (rp->lobe_variant) {
     case LOBE_EQ7:
     case LOBE_CORRECTED: break;
