@@ -312,12 +312,9 @@ static inline vec3 march_light_phase_integral(NV_CONSTANT const light_params* l,
   const vec3 c = vec3_from4(l->corner), u = vec3_from4(l->edge_u), v = vec3_from4(l->edge_v);
   /* One-sided: x must lie on the side the light faces. */
   if (!(vec3_dot(vec3_sub(x, c), vec3_from4(l->normal)) > 0.0f)) return vec3_splat(0.0f);
-  vec3 dirs[4];
-  dirs[0] = vec3_normalize(vec3_sub(c, x));
-  dirs[1] = vec3_normalize(vec3_sub(vec3_add(c, u), x));
-  dirs[2] = vec3_normalize(vec3_sub(vec3_add(vec3_add(c, u), v), x));
-  dirs[3] = vec3_normalize(vec3_sub(vec3_add(c, v), x));
-  return vec3_scale(vec3_from4(l->radiance), phase_polygon_integral(phase_kind, g, view_dir, dirs, 4));
+  const vec3 d0 = vec3_normalize(vec3_sub(c, x)), d1 = vec3_normalize(vec3_sub(vec3_add(c, u), x));
+  const vec3 d2 = vec3_normalize(vec3_sub(vec3_add(vec3_add(c, u), v), x)), d3 = vec3_normalize(vec3_sub(vec3_add(c, v), x));
+  return vec3_scale(vec3_from4(l->radiance), phase_quad_integral(phase_kind, g, view_dir, d0, d1, d2, d3));
 }
 
 /* The real-time kernels' phase over a light (realtime_params.area_light_phase): K×K points
