@@ -392,7 +392,8 @@ def warm_up(settings, scene, method):
     """One tiny render per method, thrown away: PoCL compiles again at a kernel's first launch (the
     multiple-scattering cache's build kernel too, on a 1-cell cache of 1 path per node)."""
     algorithm = METHODS[method]["algorithm"]
-    arguments = ["--algorithm", algorithm, "--spp", 1, "--resolution", "16x8"] + method_settings_arguments(method)
+    frames = ["--spp", 1] if algorithm == "pathtrace" else ["--frames", 1]
+    arguments = ["--algorithm", algorithm, "--resolution", "16x8"] + frames + method_settings_arguments(method)
     if METHODS[method]["settings"].get("multipleScattering") == "cache":
         arguments += ["--set", "renderer.raymarch.msCache.resolution=1", "--set", "renderer.raymarch.msCache.paths=1"]
     with tempfile.TemporaryDirectory(prefix="speed_vs_error_") as scratch:

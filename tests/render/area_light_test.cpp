@@ -152,9 +152,10 @@ std::vector<double> singleScatterReference(const SlabParams& P, const camera_par
   return ref;
 }
 
-TEST(RenderAreaLight, SingleScatteringWithMisMatchesQuadrature) {
-  const SlabParams P;
-  Scene scene = sceneFromJson(R"({
+// The slab and light of SlabParams seen from the camera of the reference, with `renderer` (a JSON
+// object) as the scene's renderer block.
+Scene lightSlabScene(const std::string& renderer) {
+  return sceneFromJson(R"({
     "materials": [
       {"name": "panel", "type": "emitter", "albedo": [4, 4, 4]},
       {"name": "haze", "type": "volume", "scattering": [1, 1, 1], "absorption": [0.25, 0.25, 0.25],
@@ -166,8 +167,13 @@ TEST(RenderAreaLight, SingleScatteringWithMisMatchesQuadrature) {
        "materialName": "haze"}
     ],
     "camera": {"position": [0, 0, -1.5], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 20},
-    "renderer": {"resolution": [16, 16], "spp": 8192, "bounces": 1}
+    "renderer": )" + renderer + R"(
   })");
+}
+
+TEST(RenderAreaLight, SingleScatteringWithMisMatchesQuadrature) {
+  const SlabParams P;
+  Scene scene = lightSlabScene(R"({"resolution": [16, 16], "spp": 8192, "bounces": 1})");
   const DeviceScene ds = buildDeviceScene(scene, nullptr);
   // The uploaded light is the one the reference integrates (independent derivation above).
   ASSERT_EQ(ds.params.num_lights, 1);
@@ -221,23 +227,9 @@ TEST(RenderAreaLight, SingleScatteringWithMisMatchesQuadrature) {
 TEST(RenderAreaLight, RaymarchExactPhaseMatchesQuadrature) {
   const SlabParams P;
   auto scene = [](const std::string& phase) {
-    return sceneFromJson(R"({
-      "materials": [
-        {"name": "panel", "type": "emitter", "albedo": [4, 4, 4]},
-        {"name": "haze", "type": "volume", "scattering": [1, 1, 1], "absorption": [0.25, 0.25, 0.25],
-         "phaseFunction": "hg", "g": -0.6, "density": 1}
-      ],
-      "primitives": [
-        )" + lightJson() + R"(,
-        {"name": "slab", "type": "volume", "transform": {"position": [0, 0, 0], "scale": [40, 40, 0.4]},
-         "materialName": "haze"}
-      ],
-      "camera": {"position": [0, 0, -1.5], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 20},
-      "renderer": {"resolution": [16, 16], "algorithm": "raymarch", "bounces": 1,
-                   "lightCache": {"resolution": 0},
-                   "raymarch": {"steps": 128, "shadowSteps": 16, "shadowAreaSamples": 8, "minTransmittance": 0,
-                                )" + phase + R"(}}
-    })");
+    return lightSlabScene(R"({"resolution": [16, 16], "algorithm": "raymarch", "bounces": 1, "lightCache": {"resolution": 0},
+                         "raymarch": {"steps": 128, "shadowSteps": 16, "shadowAreaSamples": 8, "minTransmittance": 0, )" +
+                     phase + "}}");
   };
   const Scene exact = scene(R"("areaLightPhase": "exact")");
   const Scene centre = scene(R"("areaLightSamples": 1)");
