@@ -22,9 +22,10 @@
  * integrand has no trigonometry and stays bounded at the pole (G/sin²θ → p(1)/2), with as many
  * 4-point Gauss panels as the arc holds phase widths: within 0.2% of the area integral for
  * Listing 4.1's light (86° × 64°) at g up to 0.9 and for a 6-unit light 20 units away, axes
- * anywhere (tests/unit/phase_polygon_test.cpp, and 200 random configurations measured). With the polygon traversed counter-clockwise about its
- * inside, φ grows along an edge whose great circle has a on its inner side. The contour counts
- * ∫ G dφ from θ = 0 outwards: the polygon's integral when it holds a or neither pole. */
+ * anywhere (tests/unit/phase_polygon_test.cpp, and 200 random configurations measured). With the
+ * polygon traversed counter-clockwise about its inside, φ grows along an edge whose great circle
+ * has a on its inner side. The contour counts ∫ G dφ from θ = 0 outwards: the polygon's integral
+ * when it holds a or neither pole. */
 #ifndef NARVAL_PHASE_POLYGON_H
 #define NARVAL_PHASE_POLYGON_H
 
@@ -49,10 +50,10 @@ static inline float phase_polygon_cap_over_sin2(int kind, float g, float mu) {
  * Along the chord p(t) = (1 − t)·v0 + t·v1, ω = p/|p| and the azimuth about a turns at
  * dφ/dt = a·(ω × dω/dt)/(1 − μ²) = a·(v0 × v1)/(|p|²·(1 − μ²))   (p × p' = v0 × v1),
  * so the share is a·(v0 × v1)·∫₀¹ G(μ)/((1 − μ²)·|p|²) dt: no trigonometry in the integrand.
- * Quadrature: 4-point Gauss–Legendre on each of n equal panels, n = ⌈arc / (4·(1 − |g|))⌉ in
- * {1, 2, 4}, the arc against the phase's width (HG falls to half its peak within about
- * 1 − |g| rad): one panel for a light of 17° at g 0.8, four for Listing 4.1's 86° edges at g 0.9.
- * n = v0 × v1, which the caller has. */
+ * Quadrature: 4-point Gauss–Legendre on 1, 2 or 4 equal panels, as the chord is under 2.5, under
+ * 5 or more phase widths 1 − |g| (HG falls to half its peak within about 1 − |g| rad): one panel
+ * for a light of 17° at g 0.8, four for Listing 4.1's 86° edges at g 0.9. n = v0 × v1, which the
+ * caller has. */
 static inline float phase_polygon_edge(int kind, float g, vec3 a, vec3 v0, vec3 v1, vec3 n) {
   const float node[4] = {0.06943184420297371f, 0.33000947820757187f, 0.6699905217924281f, 0.9305681557970263f};
   const float weight[4] = {0.17392742256872692f, 0.3260725774312731f, 0.3260725774312731f, 0.17392742256872692f};

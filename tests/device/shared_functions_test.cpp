@@ -25,6 +25,8 @@
 #include "shared/accum.h"
 #include "shared/camera.h"
 #include "shared/intersect.h"
+#include "shared/march.h"
+#include "shared/ms_cache.h"
 #include "shared/phase.h"
 #include "shared/rng.h"
 #include "shared/sampling.h"
@@ -528,6 +530,54 @@ TEST_F(SharedOnDevice, UnknownKindsSetTheStatusBitAndSendNothing) {
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
   s.medium.emission.kind = EMISSION_NONE;
   EXPECT_EQ(probe()[0], 0u);
+}
+
+// The real-time kinds (realtime_params): the area-light phase, the cache's closure and the lobe
+// variant. Known values: status 0, and the device computes what the host does (a 2x2 rectangle 2
+// units along +z, seen along +z, at its centre and exactly; the HG closure's 4πR·p_HG(gμ) with
+// μ = 0.3). An unknown one sets STATUS_UNKNOWN_KIND and its switch gives nothing.
+TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
+  realtime_params rp{};
+  std::vector<light_params> lights(1);
+  lights[0].type = LIGHT_RECTANGLE;
+  lights[0].corner = nv_float4{-1, -1, 2, 0};
+  lights[0].edge_u = nv_float4{2, 0, 0, 0};
+  lights[0].edge_v = nv_float4{0, 2, 0, 0};
+  lights[0].normal = nv_float4{0, 0, -1, 4};  // emits towards −z, at the origin; w = its area
+  lights[0].radiance = nv_float4{3, 3, 3, 0};
+  auto probe = [&]() { return run<cl_uint>("sf_realtime_kinds", 1, 3, 2, constant(rp), input(lights)); };
+  auto value = [](cl_uint u) {
+    float f;
+    std::memcpy(&f, &u, sizeof f);
+    return f;
+  };
+  const vec3 w = vec3_make(0, 0, 1);
+  for (int phase : {AREA_LIGHT_POINTS, AREA_LIGHT_EXACT})
+    for (int closure : {MS_CACHE_CLOSURE_LINEAR, MS_CACHE_CLOSURE_HG}) {
+      rp.area_light_phase = phase;
+      rp.ms_cache_closure = closure;
+      const std::vector<cl_uint> out = probe();
+      EXPECT_EQ(out[0], 0u);
+      const float host = march_light_phase(&lights[0], vec3_make(0, 0, 0), PHASE_HG, 0.5f, w, phase, 1).x;
+      EXPECT_GT(host, 0.0f);
+      EXPECT_NEAR(value(out[1]), host, 1e-5f * host) << "phase " << phase;
+      const float closed = ms_cache_closure(closure, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w);
+      EXPECT_NEAR(value(out[2]), closed, 1e-5f * closed) << "closure " << closure;
+    }
+  // HG closure, forwards: 4πR·p_HG(k, 1) = R(1 + k)/(1 − k)², k = 0.8·0.3 = 0.24: 2·1.24/0.5776.
+  EXPECT_NEAR(ms_cache_closure(MS_CACHE_CLOSURE_HG, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w), 2 * 1.24 / 0.5776, 1e-5);
+  rp.area_light_phase = 3;
+  std::vector<cl_uint> out = probe();
+  EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
+  EXPECT_EQ(value(out[1]), 0.0f);
+  rp.area_light_phase = AREA_LIGHT_EXACT;
+  rp.ms_cache_closure = 4;
+  out = probe();
+  EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
+  EXPECT_EQ(value(out[2]), 0.0f);
+  rp.ms_cache_closure = MS_CACHE_CLOSURE_HG;
+  rp.lobe_variant = 2;
+  EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
 }
 
 }  // namespace
