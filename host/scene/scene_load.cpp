@@ -228,6 +228,14 @@ float readMinTransmittance(ObjectReader& r, float fallback) {
   return v;
 }
 
+// renderer.raymarch/lobe.areaLightPhase; with "exact", a given areaLightSamples is said to be ignored.
+AreaLightPhase readAreaLightPhase(ObjectReader& r, AreaLightPhase fallback) {
+  const AreaLightPhase v = readEnum(r, "areaLightPhase", kAreaLightPhases, fallback);
+  if (v == AreaLightPhase::Exact && r.find("areaLightSamples"))
+    r.context().warn(r.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
+  return v;
+}
+
 // --- sections ---
 
 void readHenyeyGreensteinG(ObjectReader& r, Material& m) {
@@ -430,9 +438,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
                                                 ") or the octaves add energy");
     s.raymarch.minTransmittance = readMinTransmittance(m, s.raymarch.minTransmittance);
     s.raymarch.areaLightSamples = readInt(m, "areaLightSamples", s.raymarch.areaLightSamples, 1, 16);
-    s.raymarch.areaLightPhase = readEnum(m, "areaLightPhase", kAreaLightPhases, s.raymarch.areaLightPhase);
-    if (s.raymarch.areaLightPhase == AreaLightPhase::Exact && m.find("areaLightSamples"))
-      ctx.warn(m.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
+    s.raymarch.areaLightPhase = readAreaLightPhase(m, s.raymarch.areaLightPhase);
     s.raymarch.shadowAreaSamples = readInt(m, "shadowAreaSamples", s.raymarch.shadowAreaSamples, 1, 16);
     s.raymarch.multipleScattering =
         readEnum(m, "multipleScattering", kMultipleScattering,
@@ -466,9 +472,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
     if (l.find("viewSteps")) s.lobe.viewSteps = readInt(l, "viewSteps", 1, 1);
     s.lobe.minTransmittance = readMinTransmittance(l, s.lobe.minTransmittance);
     s.lobe.areaLightSamples = readInt(l, "areaLightSamples", s.lobe.areaLightSamples, 1, 16);
-    s.lobe.areaLightPhase = readEnum(l, "areaLightPhase", kAreaLightPhases, s.lobe.areaLightPhase);
-    if (s.lobe.areaLightPhase == AreaLightPhase::Exact && l.find("areaLightSamples"))
-      ctx.warn(l.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
+    s.lobe.areaLightPhase = readAreaLightPhase(l, s.lobe.areaLightPhase);
     if (l.find("shadowAreaSamples")) s.lobe.shadowAreaSamples = readInt(l, "shadowAreaSamples", 1, 1, 16);
     l.reportUnknown();
   }

@@ -27,9 +27,7 @@ typedef ulong nv_ulong; /* 64-bit unsigned (counters, tracking.h) */
 #define nv_sin sin
 #define nv_cos cos
 #define nv_tan tan
-#define nv_atan2 atan2
 #define nv_floor floor
-#define nv_ceil ceil
 #define nv_isfinite isfinite
 #define nv_pow pow
 #define nv_float_bits(x) as_uint(x)
@@ -64,9 +62,7 @@ static inline vec3 vec3_make(float x, float y, float z) {
 #define nv_sin sinf
 #define nv_cos cosf
 #define nv_tan tanf
-#define nv_atan2 atan2f
 #define nv_floor floorf
-#define nv_ceil ceilf
 #define nv_isfinite isfinite
 #define nv_pow powf
 /* The IEEE-754 bits of a float (OpenCL's as_uint). */

@@ -91,7 +91,8 @@ TEST_F(LightCacheCli, MovingALightChangesTheImage) {
 }
 
 // With the phase integrated exactly, the K×K points of areaLightSamples are not used: one warning
-// line names the key, and the image is the one rendered without it, bit for bit.
+// line names the key, and the image is the one rendered without it, bit for bit. Control: on this
+// scene (a 4x4 rectangle 4 units from the cloud) the same key does change the points' image.
 TEST_F(LightCacheCli, ExactAreaLightPhaseIgnoresAreaLightSamplesWithAWarning) {
   const RunResult a = run("render s.json -o a.exr --set renderer.raymarch.areaLightPhase=\\\"exact\\\"");
   ASSERT_EQ(a.code, 0) << a.err;
@@ -103,6 +104,9 @@ TEST_F(LightCacheCli, ExactAreaLightPhaseIgnoresAreaLightSamplesWithAWarning) {
                    "\"points\"; \"exact\" ignores it\n");
   const ImageRGB ia = readExr((dir_ / "a.exr").string()), ib = readExr((dir_ / "b.exr").string());
   EXPECT_EQ(ia.rgb, ib.rgb);
+  ASSERT_EQ(run("render s.json -o c.exr").code, 0);
+  ASSERT_EQ(run("render s.json -o d.exr --set renderer.raymarch.areaLightSamples=4").code, 0);
+  EXPECT_NE(readExr((dir_ / "c.exr").string()).rgb, readExr((dir_ / "d.exr").string()).rgb);
 }
 
 TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
