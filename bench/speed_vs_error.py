@@ -8,7 +8,8 @@ parameters and sweeps (full mode; each sweep varies one parameter from the base)
   raymarch-none     multipleScattering "none", octaves 1: steps 15,30,60,120; shadowSteps 5,10,20
   raymarch-octaves  multipleScattering "octaves": octaves 2,4,8 (base 4); steps 30,60,120
   raymarch-cache    multipleScattering "cache", octaves 1: msCache.resolution 8,16,32 (base 16);
-                    msCache.paths 64,256,1024 (base 256); steps 30,60,120
+                    msCache.paths 64,256,1024 (base 256); steps 30,60,120; shadowAreaSamples 1,4;
+                    areaLightSamples 1,2; areaLightPhase points,exact; msCache.closure linear,hg,camera
   lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
   lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
 Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
@@ -105,7 +106,7 @@ FULL_SWEEPS = {
     "raymarch-octaves": {"octaves": [2, 4, 8], "steps": [30, 60, 120]},
     "raymarch-cache": {"msCache.resolution": [8, 16, 32], "msCache.paths": [64, 256, 1024], "steps": [30, 60, 120],
                        "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2], "areaLightPhase": ["points", "exact"],
-                       "msCache.closure": ["linear", "hg"]},
+                       "msCache.closure": ["linear", "hg", "camera"]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},

@@ -14,11 +14,15 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   const node_grid_params& c = params.ms_cache;
   if (c.nx <= 0) throw std::invalid_argument("DeviceMsCache::refine: the cache is off (nx = 0)");
   const size_t nodes = nodeGridCount(c);
-  // The paths see the whole scene but the camera: medium, grid, lights, bounces, seed, background.
+  // The paths see the whole scene but the camera (medium, grid, lights, bounces, seed, background),
+  // and the camera too when they aim at it (MS_CACHE_CLOSURE_CAMERA: the cache starts over when it
+  // moves).
+  const bool towardsCamera = params.ms_cache_closure == MS_CACHE_CLOSURE_CAMERA;
   scene_params pathScene = dev.scene.params;
-  pathScene.camera = camera_params{};
+  if (!towardsCamera) pathScene.camera = camera_params{};
   pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
-  std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions();
+  std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions() +
+                    (towardsCamera ? "camera" : "uniform");
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
@@ -39,7 +43,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   if (paths_ >= targetPaths) return;
   paramBuf_ = constantBuffer(rt, params);
   dev.bind(kernel_);
-  kernel_.set("scene", sceneBuf_);  // the scene the paths see (no camera, one bounce fewer)
+  kernel_.set("scene", sceneBuf_);  // the scene the paths see (one bounce fewer)
   kernel_.set("params", paramBuf_);
   kernel_.set("cache", buffer_);
   kernel_.set("status_word", statusBuf_);

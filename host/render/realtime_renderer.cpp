@@ -55,6 +55,7 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   switch (r.raymarch.msCache.closure) {
     case MsCacheClosure::Linear: p.ms_cache_closure = MS_CACHE_CLOSURE_LINEAR; break;
     case MsCacheClosure::Hg: p.ms_cache_closure = MS_CACHE_CLOSURE_HG; break;
+    case MsCacheClosure::Camera: p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA; break;
   }
   return p;
 }

@@ -98,7 +98,7 @@ enum class AreaLightPhase { Points, Exact };
 // What the cache's two moments (directional average R, first moment b) say about the
 // in-scattering in a direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear
 // expansion, or the HG lobe with those moments.
-enum class MsCacheClosure { Linear, Hg };
+enum class MsCacheClosure { Linear, Hg, Camera };
 
 struct MsCacheSettings {
   MsCacheClosure closure = MsCacheClosure::Linear;

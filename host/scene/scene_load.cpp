@@ -76,8 +76,9 @@
 // |                         | a rectangle light               |     |             | integral (phase_polygon.h) |
 // |   raymarch.shadowAreaSamples | integer: K×K points per    |     | 4           | [1, 16]; 1 = the centre    |
 // |                         | rectangle light (shadow)        |     |             |                            |
-// |   raymarch.msCache.closure | linear, hg: the in-scattering  |     | linear      | ms_cache.h, "Closure"      |
-// |                         | its two moments give a direction|     |             |                            |
+// |   raymarch.msCache.closure | linear, hg: the in-scattering  |     | linear      | ms_cache.h, "Closure";     |
+// |                         | its two moments give a direction;|    |             | camera: rebuilt when the   |
+// |                         | camera: estimated towards it    |     |             | camera moves               |
 // |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]                   |
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
 // |   lobe.variant          | eq7, corrected (lobe.h)         |     | eq7         |                            |
@@ -177,7 +178,7 @@ const EnumNames<LightSampling> kLightSamplings = {
     {"all", LightSampling::All}, {"power", LightSampling::Power}, {"fluence", LightSampling::Fluence}};
 const EnumNames<AreaLightPhase> kAreaLightPhases = {{"points", AreaLightPhase::Points},
                                                      {"exact", AreaLightPhase::Exact}};
-const EnumNames<MsCacheClosure> kMsCacheClosures = {{"linear", MsCacheClosure::Linear}, {"hg", MsCacheClosure::Hg}};
+const EnumNames<MsCacheClosure> kMsCacheClosures = {{"linear", MsCacheClosure::Linear}, {"hg", MsCacheClosure::Hg}, {"camera", MsCacheClosure::Camera}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
 const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
                                           {"raymarch", Algorithm::Raymarch},

@@ -37,6 +37,15 @@
  *   ∫ p_HG(g, w·w_out) L(w) dw = 4πR·p_HG(gμ, b̂·w_out) = R·(1 − k²)/(1 + k² − 2k·b̂·w_out)^{3/2},  k = gμ,
  * positive in every direction, equal to the linear closure to first order in μ, and R for an
  * isotropic field (μ = 0). μ is kept below 0.99 (a noisy b can exceed its bound).
+ * Neither is right everywhere: the default cloud's dark front, a broad one-sided field, wants the
+ * linear one, its sunlit rim, a field peaked around several directions, more than HG gives.
+ * MS_CACHE_CLOSURE_CAMERA asks no closure: each node's paths draw their directions from the phase
+ * function about the direction from the node to the camera (w_c), so that their mean radiance
+ * estimates the in-scattering towards the camera itself, ∫ p(w·w_c) L(w) dw (importance sampled:
+ * the weight p/pdf is 1), which the lookup returns as it is. Exact in direction up to w_c being
+ * the node's and not the sample's (the camera far from the box: degrees apart), it is the same
+ * estimator as the uniform one for an isotropic phase function, and it depends on where the camera
+ * is: the host starts the cache over when the camera moves (render/ms_cache.cpp).
  *
  * Interpolation: R is interpolated geometrically, exp(Σ w_k ln R_k) with the trilinear weights
  * w_k, and the moment per unit R, b/R, linearly. In a dense medium the radiance falls off
@@ -80,6 +89,7 @@ static inline float ms_cache_closure(int closure, float R, float g, vec3 m, vec3
       const float d = 1.0f + k * k - 2.0f * k * (vec3_dot(m, w_out) / len);
       return R * (1.0f - k * k) / (d * nv_sqrt(d));
     }
+    case MS_CACHE_CLOSURE_CAMERA: return R; /* the node's R is the in-scattering towards the camera */
     default: return 0.0f; /* unknown: reported at the kernel's entry */
   }
 }
@@ -93,6 +103,7 @@ static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLO
   size_t at[8];
   node_grid_corners(c, node_grid_locate(c, dims, p), MS_CACHE_STRIDE, at, w);
   float out[3];
+  const int want_ratio = g != 0.0f && closure != MS_CACHE_CLOSURE_CAMERA; /* b/R read only for a closure */
   for (int ch = 0; ch < 3; ++ch) {
     /* R geometrically ("Interpolation"), the moment per unit R linearly: from the node's ln R and
      * b/R when every corner has R > 0 (the build stores them: no log or division here), else from
@@ -104,7 +115,7 @@ static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLO
     if (all_lit) {
       for (int k = 0; k < 8; ++k) {
         log_r += w[k] * cache[at[k] + MS_CACHE_LOG_R + (size_t)ch];
-        if (g != 0.0f) {
+        if (want_ratio) {
           NV_GLOBAL const float* q = cache + at[k] + MS_CACHE_RATIO + 3 * ch;
           ratio = vec3_add(ratio, vec3_scale(vec3_make(q[0], q[1], q[2]), w[k]));
         }

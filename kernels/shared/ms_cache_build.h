@@ -11,16 +11,36 @@
  * share the numbers of pixel n's camera samples. */
 #define MS_CACHE_SEED_OFFSET 0x6d73u
 
-/* Path k's estimate at node `node`: the radiance of the rest arriving from a uniform direction,
- * and the direction ω it looked along. */
-static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM,
-                                 NV_CONSTANT const node_grid_params* c, int node, uint k, NV_PRIVATE vec3* omega) {
+/* The direction path k looks along, ω: uniform on the sphere (pdf 1/4π: the mean radiance is R and
+ * −3·L·ω estimates b), or for MS_CACHE_CLOSURE_CAMERA the reverse of a propagation direction w
+ * drawn from the phase function about w_c, the direction from x to the camera (the mean radiance is
+ * then the in-scattering towards the camera; ms_cache.h, "Closure"). A node at the camera's very
+ * position takes w_c = −forward. */
+static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int closure, vec3 x, float u1, float u2) {
+  switch (closure) {
+    case MS_CACHE_CLOSURE_LINEAR:
+    case MS_CACHE_CLOSURE_HG: return sample_uniform_sphere(u1, u2);
+    case MS_CACHE_CLOSURE_CAMERA: {
+      const vec3 to_camera = vec3_sub(vec3_from4(s->camera.position), x);
+      const float d = vec3_length(to_camera);
+      const vec3 w_c = d > 0.0f ? vec3_scale(to_camera, 1.0f / d) : vec3_scale(vec3_from4(s->camera.forward), -1.0f);
+      float pdf;
+      return vec3_scale(phase_sample(s->medium.phase, s->medium.g, w_c, u1, u2, &pdf), -1.0f);
+    }
+    default: return sample_uniform_sphere(u1, u2); /* unknown: reported at the kernel's entry */
+  }
+}
+
+/* Path k's estimate at node `node`: the radiance of the rest arriving along a direction drawn by
+ * ms_cache_direction, and the direction ω it looked along. */
+static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_grid_params* c, int closure, int node,
+                                 uint k, NV_PRIVATE vec3* omega) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
   const vec3 x = affine_point(c->index_to_world, node_grid_point(c, vec3_from4(s->medium.dims), node));
   rng_state rng = rng_init(s->seed + MS_CACHE_SEED_OFFSET, (uint)node, k);
   const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
-  *omega = sample_uniform_sphere(u1, u2);
+  *omega = ms_cache_direction(s, closure, x, u1, u2);
   const vec3 L = pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, 0, &rng);
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
@@ -31,11 +51,11 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM,
 
 /* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"):
  * v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then ln R and b/R. */
-static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_grid_params* c, int node,
-                                        NV_GLOBAL float* v, uint first, uint count) {
+static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_grid_params* c, int closure,
+                                        int node, NV_GLOBAL float* v, uint first, uint count) {
   for (uint k = first; k < first + count; ++k) {
     vec3 omega;
-    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, c, node, k, &omega);
+    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, c, closure, node, k, &omega);
     const float n = (float)(k + 1u);
     const float Lc[3] = {L.x, L.y, L.z};
     const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */

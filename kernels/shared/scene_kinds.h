@@ -53,7 +53,8 @@ static inline uint realtime_kinds_status(NV_CONSTANT const realtime_params* rp) 
   }
   switch (rp->ms_cache_closure) {
     case MS_CACHE_CLOSURE_LINEAR:
-    case MS_CACHE_CLOSURE_HG: break;
+    case MS_CACHE_CLOSURE_HG:
+    case MS_CACHE_CLOSURE_CAMERA: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
   switch (rp->lobe_variant) {

@@ -126,9 +126,11 @@ typedef struct node_grid_params {
 #define AREA_LIGHT_POINTS 0
 #define AREA_LIGHT_EXACT 1
 
-/* What the multiple-scattering cache's two moments say about a direction (ms_cache.h, "Closure"). */
+/* How the multiple-scattering cache answers for a direction (ms_cache.h, "Closure"): from its two
+ * moments, or (CAMERA) with the in-scattering towards the camera estimated directly. */
 #define MS_CACHE_CLOSURE_LINEAR 0
 #define MS_CACHE_CLOSURE_HG 1
+#define MS_CACHE_CLOSURE_CAMERA 2
 
 /* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
 typedef struct realtime_params {
@@ -149,7 +151,7 @@ typedef struct realtime_params {
   int area_light_samples;   /* K: a rectangle is K×K points for the phase and 1/d² (march_light_phase_sum) */
   int shadow_area_samples;  /* K: a rectangle's shadow averaged over K×K points (march_light_column) */
   int area_light_phase;     /* AREA_LIGHT_POINTS (area_light_samples) or AREA_LIGHT_EXACT (march_light_phase) */
-  int ms_cache_closure;     /* raymarch: MS_CACHE_CLOSURE_LINEAR or _HG (ms_cache.h, "Closure") */
+  int ms_cache_closure;     /* raymarch: MS_CACHE_CLOSURE_LINEAR, _HG or _CAMERA (ms_cache.h, "Closure") */
 } realtime_params;
 
 typedef struct scene_params {

@@ -553,7 +553,7 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
   };
   const vec3 w = vec3_make(0, 0, 1);
   for (int phase : {AREA_LIGHT_POINTS, AREA_LIGHT_EXACT})
-    for (int closure : {MS_CACHE_CLOSURE_LINEAR, MS_CACHE_CLOSURE_HG}) {
+    for (int closure : {MS_CACHE_CLOSURE_LINEAR, MS_CACHE_CLOSURE_HG, MS_CACHE_CLOSURE_CAMERA}) {
       rp.area_light_phase = phase;
       rp.ms_cache_closure = closure;
       const std::vector<cl_uint> out = probe();
@@ -564,6 +564,8 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
       const float closed = ms_cache_closure(closure, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w);
       EXPECT_NEAR(value(out[2]), closed, 1e-5f * closed) << "closure " << closure;
     }
+  // The camera closure: the node's R is already the in-scattering towards the camera.
+  EXPECT_EQ(ms_cache_closure(MS_CACHE_CLOSURE_CAMERA, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w), 2.0f);
   // HG closure, forwards: 4πR·p_HG(k, 1) = R(1 + k)/(1 − k)², k = 0.8·0.3 = 0.24: 2·1.24/0.5776.
   EXPECT_NEAR(ms_cache_closure(MS_CACHE_CLOSURE_HG, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w), 2 * 1.24 / 0.5776, 1e-5);
   rp.area_light_phase = 3;

@@ -43,20 +43,25 @@ inline RenderResult renderAlgorithm(const Scene& scene, SceneGrids grid = {}) {
 // with octaves (and 2x2 phase points per rectangle light), with its multiple-scattering cache
 // ("raymarch+ms-cache": a small one, 4 cells and 8 paths per node, so the suites stay fast; every
 // code path of the cache's build and lookup runs; with the phase integrated exactly over rectangle
-// lights and the HG closure) and the corrected Lobe Estimator (its phase exact as well).
-inline const char* const kHardCaseRenderers[] = {"pathtrace", "raymarch", "raymarch+octaves", "raymarch+ms-cache",
-                                                 "lobe", "lobe+corrected"};
+// lights and the HG closure; "raymarch+ms-cache-camera" the same cache with its paths aimed at the
+// camera) and the corrected Lobe Estimator (its phase exact as well).
+inline const char* const kHardCaseRenderers[] = {"pathtrace",         "raymarch",
+                                                 "raymarch+octaves",  "raymarch+ms-cache",
+                                                 "raymarch+ms-cache-camera", "lobe",
+                                                 "lobe+corrected"};
 
 // `scene` rendered by one of kHardCaseRenderers (or any algorithm name), one frame for the
 // real-time ones.
 inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGrids grid = {}) {
-  if (renderer == "raymarch+ms-cache") {
+  if (renderer == "raymarch+ms-cache" || renderer == "raymarch+ms-cache-camera") {
     scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
     scene.renderer.raymarch.msCache.resolution = 4;
     scene.renderer.raymarch.msCache.paths = 8;
     scene.renderer.raymarch.areaLightPhase = AreaLightPhase::Exact;  // the phase over a rectangle's solid angle
-    scene.renderer.raymarch.msCache.closure = MsCacheClosure::Hg;     // and the HG closure of the moments
+    scene.renderer.raymarch.msCache.closure = renderer == "raymarch+ms-cache"
+                                                  ? MsCacheClosure::Hg       // the HG closure of the moments
+                                                  : MsCacheClosure::Camera;  // the paths aimed at the camera
   } else if (renderer == "raymarch+octaves") {
     scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Octaves;
