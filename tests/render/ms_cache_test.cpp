@@ -119,6 +119,13 @@ TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
   for (size_t i = 3; i < one.size(); i += MS_CACHE_STRIDE) ASSERT_EQ(one[i], 48.0f);  // the count
 }
 
+// refine() to `paths` paths per node for `scene` seen from another camera position, (1, 1, −4).
+void refineFromAnotherCamera(DeviceMsCache& cache, Scene scene, int paths) {
+  scene.camera.position = {1, 1, -4};
+  DeviceSceneBuffers dev(runtime(), scene, nullptr);
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), paths, 8, "camera");
+}
+
 // Kept across frames and camera moves, started over when the medium or a light changes: refine()
 // to the same count builds nothing; another camera keeps the paths; a moved light starts over.
 TEST(MsCache, StartsOverOnlyWhenWhatThePathsSeeChanges) {
@@ -131,10 +138,7 @@ TEST(MsCache, StartsOverOnlyWhenWhatThePathsSeeChanges) {
   EXPECT_EQ(cache.paths(), 8);
   cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 12, 8, "a");  // progressive: 4 more
   EXPECT_EQ(cache.paths(), 12);
-  Scene camera = scene;
-  camera.camera.position = {1, 1, -4};
-  DeviceSceneBuffers devCamera(runtime(), camera, nullptr);
-  cache.refine(runtime(), devCamera, realtimeParams(camera, devCamera.scene), 12, 8, "camera");
+  refineFromAnotherCamera(cache, scene, 12);
   EXPECT_EQ(cache.rebuilds(), 1);
   Scene moved = scene;
   moved.primitives[0].transform.position = {0.5f, 0, 3};
@@ -160,10 +164,7 @@ TEST(MsCache, TheCameraClosureStartsOverWhenTheCameraMoves) {
   EXPECT_EQ(cache.rebuilds(), 2);
   cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
   EXPECT_EQ(cache.rebuilds(), 2);
-  Scene camera = scene;
-  camera.camera.position = {1, 1, -4};
-  DeviceSceneBuffers devCamera(runtime(), camera, nullptr);
-  cache.refine(runtime(), devCamera, realtimeParams(camera, devCamera.scene), 8, 8, "camera");
+  refineFromAnotherCamera(cache, scene, 8);
   EXPECT_EQ(cache.rebuilds(), 3);
   EXPECT_EQ(cache.paths(), 8);
   EXPECT_EQ(cache.status(), 0u);
