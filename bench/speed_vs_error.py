@@ -9,7 +9,9 @@ parameters and sweeps (full mode; each sweep varies one parameter from the base)
   raymarch-octaves  multipleScattering "octaves": octaves 2,4,8 (base 4); steps 30,60,120
   raymarch-cache    multipleScattering "cache", octaves 1: msCache.resolution 8,16,32 (base 16);
                     msCache.paths 64,256,1024 (base 256); steps 30,60,120; shadowAreaSamples 1,4;
-                    areaLightSamples 1,2; areaLightPhase points,exact; msCache.closure linear,hg,camera
+                    areaLightSamples 1,2; areaLightPhase points,exact; msCache.closure linear,hg
+  raymarch-cache-camera  the same with msCache.closure "camera" (the cache's paths aimed at the
+                    camera): msCache.resolution 16,32; msCache.paths 256,1024; areaLightPhase points,exact
   lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
   lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
 Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
@@ -27,7 +29,7 @@ the front); a scene whose volume file is absent is skipped, saying why):
   2. every method across its sweeps (pathtrace with seed 2, not the reference's). Time: the stats'
      `seconds` per image for pathtrace; per frame for the others, the median of `--frames 3`
      (kernel time by profiling events); each method gets one tiny warm-up render first (PoCL
-     compiles again at the first launch). raymarch-cache rows also record `build_seconds`, the
+     compiles again at the first launch). raymarch-cache(-camera) rows also record `build_seconds`, the
      multiple-scattering cache's build (stats `ms_cache_ms`), which is not part of the frame time;
   3. `narval compare REFERENCE TEST --json` under the scene's display transform (its exposure and
      tone mapping, as narval's PNG shows it) for mean ΔE76, JND76% (ΔE76 > 2.3), mean ΔE2000 and
@@ -94,6 +96,10 @@ METHODS = {
     "raymarch-cache": {"algorithm": "raymarch", "settings": {"multipleScattering": "cache", "octaves": 1},
                        "base": {"msCache.resolution": 16, "msCache.paths": 256},
                        "style": ("triangle-down", "#e7298a")},
+    "raymarch-cache-camera": {"algorithm": "raymarch",
+                              "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.closure": "camera"},
+                              "base": {"msCache.resolution": 16, "msCache.paths": 256},
+                              "style": ("square", "#66a61e")},
     "lobe-eq7": {"algorithm": "lobe", "settings": {"variant": "eq7"}, "base": {}, "style": ("triangle", "#1b9e77")},
     "lobe-corrected": {"algorithm": "lobe", "settings": {"variant": "corrected"}, "base": {"viewSteps": 16},
                        "style": ("cross", "#7570b3")},
@@ -106,7 +112,9 @@ FULL_SWEEPS = {
     "raymarch-octaves": {"octaves": [2, 4, 8], "steps": [30, 60, 120]},
     "raymarch-cache": {"msCache.resolution": [8, 16, 32], "msCache.paths": [64, 256, 1024], "steps": [30, 60, 120],
                        "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2], "areaLightPhase": ["points", "exact"],
-                       "msCache.closure": ["linear", "hg", "camera"]},
+                       "msCache.closure": ["linear", "hg"]},
+    "raymarch-cache-camera": {"msCache.resolution": [16, 32], "msCache.paths": [256, 1024],
+                              "areaLightPhase": ["points", "exact"]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},
@@ -116,6 +124,7 @@ QUICK_SWEEPS = {
     "raymarch-none": {"steps": [15, 60], "shadowSteps": [5, 20]},
     "raymarch-octaves": {"octaves": [2, 4], "steps": [30, 60]},
     "raymarch-cache": {"msCache.resolution": [8, 16], "msCache.paths": [64, 256], "steps": [30, 60]},
+    "raymarch-cache-camera": {"msCache.resolution": [8, 16], "msCache.paths": [64, 256]},
     "lobe-eq7": {"lobePoints": [10, 30], "depthFactor": [5, 100], "shadowSteps": [25, 100]},
     "lobe-corrected": {"lobePoints": [10, 30], "lobeRadius": [0.3, 3], "viewSteps": [8, 16]},
 }
