@@ -11,7 +11,8 @@ parameters and sweeps (full mode; each sweep varies one parameter from the base)
                     msCache.paths 64,256,1024 (base 256); steps 30,60,120; shadowAreaSamples 1,4;
                     areaLightSamples 1,2; areaLightPhase points,exact; msCache.closure linear,hg
   raymarch-cache-camera  the same with msCache.closure "camera" (the cache's paths aimed at the
-                    camera): msCache.resolution 16,32; msCache.paths 256,1024; areaLightPhase points,exact
+                    camera): msCache.resolution 16,32; msCache.paths 256,1024; areaLightPhase points,exact;
+                    msCache.interpolation geometric,linear
   lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
   lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
 Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
@@ -114,7 +115,7 @@ FULL_SWEEPS = {
                        "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2], "areaLightPhase": ["points", "exact"],
                        "msCache.closure": ["linear", "hg"]},
     "raymarch-cache-camera": {"msCache.resolution": [16, 32], "msCache.paths": [256, 1024],
-                              "areaLightPhase": ["points", "exact"]},
+                              "areaLightPhase": ["points", "exact"], "msCache.interpolation": ["geometric", "linear"]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},
@@ -132,7 +133,8 @@ QUICK_SWEEPS = {
 # host/scene/scene_load.cpp); dotted names are nested objects (renderer.raymarch.msCache.resolution).
 REALTIME_DEFAULTS = {
     "raymarch": {"steps": 60, "shadowSteps": 10, "octaves": 1, "msCache.resolution": 16, "msCache.paths": 256,
-                 "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points", "msCache.closure": "linear"},
+                 "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points", "msCache.closure": "linear",
+                 "msCache.interpolation": "geometric"},
     "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24,
              "areaLightPhase": "points"},
 }

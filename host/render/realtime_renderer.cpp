@@ -57,6 +57,10 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
     case MsCacheClosure::Hg: p.ms_cache_closure = MS_CACHE_CLOSURE_HG; break;
     case MsCacheClosure::Camera: p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA; break;
   }
+  switch (r.raymarch.msCache.interpolation) {
+    case MsCacheInterpolation::Geometric: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_GEOMETRIC; break;
+    case MsCacheInterpolation::Linear: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_LINEAR; break;
+  }
   return p;
 }
 

@@ -99,9 +99,12 @@ enum class AreaLightPhase { Points, Exact };
 // in-scattering in a direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear
 // expansion, or the HG lobe with those moments.
 enum class MsCacheClosure { Linear, Hg, Camera };
+// How the cache mixes its nodes (kernels/shared/ms_cache.h, "Interpolation").
+enum class MsCacheInterpolation { Geometric, Linear };
 
 struct MsCacheSettings {
   MsCacheClosure closure = MsCacheClosure::Linear;
+  MsCacheInterpolation interpolation = MsCacheInterpolation::Geometric;
   int resolution = 16;      // cells on the medium box's longest axis
   int paths = 256;          // paths per node
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)

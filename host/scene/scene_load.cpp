@@ -79,6 +79,8 @@
 // |   raymarch.msCache.closure | linear, hg: the in-scattering  |     | linear      | ms_cache.h, "Closure";     |
 // |                         | its two moments give a direction;|    |             | camera: rebuilt when the   |
 // |                         | camera: estimated towards it    |     |             | camera moves               |
+// |   raymarch.msCache.interpolation | geometric, linear: how   |     | geometric   | ms_cache.h, "Interpolation"|
+// |                         | the nodes are mixed             |     |             |                            |
 // |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]                   |
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
 // |   lobe.variant          | eq7, corrected (lobe.h)         |     | eq7         |                            |
@@ -178,7 +180,10 @@ const EnumNames<LightSampling> kLightSamplings = {
     {"all", LightSampling::All}, {"power", LightSampling::Power}, {"fluence", LightSampling::Fluence}};
 const EnumNames<AreaLightPhase> kAreaLightPhases = {{"points", AreaLightPhase::Points},
                                                      {"exact", AreaLightPhase::Exact}};
-const EnumNames<MsCacheClosure> kMsCacheClosures = {{"linear", MsCacheClosure::Linear}, {"hg", MsCacheClosure::Hg}, {"camera", MsCacheClosure::Camera}};
+const EnumNames<MsCacheClosure> kMsCacheClosures = {
+    {"linear", MsCacheClosure::Linear}, {"hg", MsCacheClosure::Hg}, {"camera", MsCacheClosure::Camera}};
+const EnumNames<MsCacheInterpolation> kMsCacheInterpolations = {{"geometric", MsCacheInterpolation::Geometric},
+                                                                {"linear", MsCacheInterpolation::Linear}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
 const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
                                           {"raymarch", Algorithm::Raymarch},
@@ -449,6 +454,8 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
     if (const json* c = m.find("msCache")) {
       ObjectReader mc(ctx, *c, m.keyOf("msCache"));
       s.raymarch.msCache.closure = readEnum(mc, "closure", kMsCacheClosures, s.raymarch.msCache.closure);
+      s.raymarch.msCache.interpolation =
+          readEnum(mc, "interpolation", kMsCacheInterpolations, s.raymarch.msCache.interpolation);
       s.raymarch.msCache.resolution = readInt(mc, "resolution", s.raymarch.msCache.resolution, 1, 256);
       s.raymarch.msCache.paths = readInt(mc, "paths", s.raymarch.msCache.paths, 1, 1 << 20);
       s.raymarch.msCache.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.raymarch.msCache.pathsPerLaunch, 1, 1 << 20);

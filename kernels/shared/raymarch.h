@@ -163,6 +163,7 @@ static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const real
       if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h) */
         Li = vec3_add(Li, ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), vec3_madd(seg->o, seg->d, t),
                                           phase_mean_cosine(m->phase, m->g), rp->ms_cache_closure,
+                                          rp->ms_cache_interpolation,
                                           vec3_scale(dir, -1.0f)));
       S = vec3_mul(sigma_s, Li);
     }

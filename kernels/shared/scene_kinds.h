@@ -57,6 +57,11 @@ static inline uint realtime_kinds_status(NV_CONSTANT const realtime_params* rp) 
     case MS_CACHE_CLOSURE_CAMERA: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
+  switch (rp->ms_cache_interpolation) {
+    case MS_CACHE_INTERPOLATION_GEOMETRIC:
+    case MS_CACHE_INTERPOLATION_LINEAR: break;
+    default: status |= STATUS_UNKNOWN_KIND;
+  }
   switch (rp->lobe_variant) {
     case LOBE_EQ7:
     case LOBE_CORRECTED: break;

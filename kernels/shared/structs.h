@@ -132,6 +132,10 @@ typedef struct node_grid_params {
 #define MS_CACHE_CLOSURE_HG 1
 #define MS_CACHE_CLOSURE_CAMERA 2
 
+/* How the multiple-scattering cache mixes its nodes (ms_cache.h, "Interpolation"). */
+#define MS_CACHE_INTERPOLATION_GEOMETRIC 0
+#define MS_CACHE_INTERPOLATION_LINEAR 1
+
 /* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
 typedef struct realtime_params {
   int steps;            /* raymarch: samples over the view ray's segment; lobe: first-hit search samples */
@@ -152,6 +156,10 @@ typedef struct realtime_params {
   int shadow_area_samples;  /* K: a rectangle's shadow averaged over K×K points (march_light_column) */
   int area_light_phase;     /* AREA_LIGHT_POINTS (area_light_samples) or AREA_LIGHT_EXACT (march_light_phase) */
   int ms_cache_closure;     /* raymarch: MS_CACHE_CLOSURE_LINEAR, _HG or _CAMERA (ms_cache.h, "Closure") */
+  int ms_cache_interpolation; /* raymarch: MS_CACHE_INTERPOLATION_GEOMETRIC or _LINEAR ("Interpolation") */
+  int pad0;
+  int pad1;
+  int pad2;
 } realtime_params;
 
 typedef struct scene_params {

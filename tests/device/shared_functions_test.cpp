@@ -580,6 +580,10 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
   rp.ms_cache_closure = MS_CACHE_CLOSURE_HG;
   rp.lobe_variant = 2;
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
+  rp.lobe_variant = LOBE_CORRECTED;
+  EXPECT_EQ(probe()[0], 0u);
+  rp.ms_cache_interpolation = 2;
+  EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
 }
 
 }  // namespace
