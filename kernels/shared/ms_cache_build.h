@@ -49,6 +49,33 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_gr
   return L;
 }
 
+/* Whether a lookup can read node `node`. The march looks the cache up only at samples of positive
+ * density, and a sample reads the eight nodes of its cell, each within one node spacing h of it
+ * along every axis; the majorant grid bounds the density in each of its cells (majorant.h). So a
+ * node is read only if a majorant cell overlapping [p − h, p + h] (p the node's index-space point;
+ * widened by the cells' own padding, MAJORANT_SLACK) has a positive bound: the build skips the
+ * others, the empty space around a cloud or a plume.
+ * Without a majorant grid (the global majorant): every node. */
+static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_grid_params* c, int node) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  const majorant_grid_params g = m->majorant_grid;
+  if (g.cells_x <= 0 || g.cells_y <= 0 || g.cells_z <= 0) return 1;
+  const vec3 dims = vec3_from4(m->dims), p = node_grid_point(c, dims, node);
+  const vec3 h = vec3_make(dims.x / (float)(c->nx - 1), dims.y / (float)(c->ny - 1), dims.z / (float)(c->nz - 1));
+  int lo[3], hi[3];
+  const float pc[3] = {p.x, p.y, p.z}, hc[3] = {h.x, h.y, h.z}, size[3] = {g.cell_size.x, g.cell_size.y, g.cell_size.z};
+  const int n[3] = {g.cells_x, g.cells_y, g.cells_z};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = (int)nv_fmax(0.0f, nv_floor((pc[a] - hc[a] - MAJORANT_SLACK) / size[a]));
+    hi[a] = (int)nv_fmin((float)(n[a] - 1), nv_floor((pc[a] + hc[a] + MAJORANT_SLACK) / size[a]));
+  }
+  for (int k = lo[2]; k <= hi[2]; ++k)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i)
+        if (GRID_MAJORANTS[i + g.cells_x * (j + g.cells_y * k)] > 0.0f) return 1;
+  return 0;
+}
+
 /* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"):
  * v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then ln R and b/R. */
 static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_grid_params* c, int closure,
