@@ -61,7 +61,7 @@
  * instead (b/R = Σ w_k b_k / Σ w_k R_k): exact for a field linear along each axis, where the
  * geometric mean falls short of it (by the AM–GM inequality: 6% at the middle of two nodes a factor
  * 2 apart). Which is nearer depends on the medium: the default cloud, where the camera-aimed cache
- * varies gently, reads 3–5% dark throughout with the geometric mean (JND 9.3% → 8.5% with the
+ * varies gently, reads 4–5% dark throughout with the geometric mean (JND 9.3% → 8.5% with the
  * linear one, 32 cells, against an 8192-spp reference); the back-lit Disney cloud paints blocks with
  * the linear one (13.7% → 17.3%).
  *
@@ -101,6 +101,58 @@ static inline float ms_cache_closure(int closure, float R, float g, vec3 m, vec3
   }
 }
 
+/* Node `node`'s first moment b of channel ch, from its running means ("Storage"). */
+static inline vec3 ms_cache_node_moment(NV_GLOBAL const float* node, int ch) {
+  return vec3_make(node[4 + 4 * ch], node[5 + 4 * ch], node[6 + 4 * ch]);
+}
+
+/* Channel ch's R at the point whose corners and trilinear weights are at[] and w[], mixed
+ * geometrically ("Interpolation"), and its moment per unit R mixed linearly (*ratio, read only when
+ * want_ratio): from the nodes' ln R and b/R when every corner has R > 0 (the build stores them: no
+ * log or division here), else from the running means with R + floor. */
+static inline float ms_cache_mix_geometric(NV_GLOBAL const float* cache, NV_PRIVATE const size_t* at,
+                                           NV_PRIVATE const float* w, int ch, int want_ratio,
+                                           NV_PRIVATE vec3* ratio) {
+  int all_lit = 1;
+  for (int k = 0; k < 8; ++k) all_lit &= cache[at[k] + MS_CACHE_LOG_R + (size_t)ch] > -NV_INFINITY;
+  float log_r = 0.0f, floor = 0.0f;
+  if (all_lit) {
+    for (int k = 0; k < 8; ++k) {
+      log_r += w[k] * cache[at[k] + MS_CACHE_LOG_R + (size_t)ch];
+      if (want_ratio) {
+        NV_GLOBAL const float* q = cache + at[k] + MS_CACHE_RATIO + 3 * ch;
+        *ratio = vec3_add(*ratio, vec3_scale(vec3_make(q[0], q[1], q[2]), w[k]));
+      }
+    }
+  } else {
+    float top = 0.0f;
+    for (int k = 0; k < 8; ++k) top = nv_fmax(top, cache[at[k] + (size_t)ch]);
+    if (!(top > 0.0f)) return 0.0f;
+    floor = MS_CACHE_LOG_FLOOR * top;
+    for (int k = 0; k < 8; ++k) {
+      NV_GLOBAL const float* node = cache + at[k];
+      const float r = nv_fmax(node[ch], 0.0f) + floor;
+      log_r += w[k] * nv_log(r);
+      *ratio = vec3_add(*ratio, vec3_scale(ms_cache_node_moment(node, ch), w[k] / r));
+    }
+  }
+  return nv_fmax(nv_exp(log_r) - floor, 0.0f);
+}
+
+/* The same with R and b mixed linearly, b/R = Σ w_k b_k / Σ w_k R_k ("Interpolation"). */
+static inline float ms_cache_mix_linear(NV_GLOBAL const float* cache, NV_PRIVATE const size_t* at,
+                                        NV_PRIVATE const float* w, int ch, int want_ratio, NV_PRIVATE vec3* ratio) {
+  float R = 0.0f;
+  for (int k = 0; k < 8; ++k) {
+    NV_GLOBAL const float* node = cache + at[k];
+    R += w[k] * node[ch];
+    if (want_ratio) *ratio = vec3_add(*ratio, vec3_scale(ms_cache_node_moment(node, ch), w[k]));
+  }
+  R = nv_fmax(R, 0.0f);
+  *ratio = R > 0.0f ? vec3_scale(*ratio, 1.0f / R) : vec3_splat(0.0f);
+  return R;
+}
+
 /* The in-scattered radiance of the rest at index-space point p (inside the box [0, dims]) towards
  * w_out (the propagation direction after scattering), per unit σs: R over the cell's eight nodes
  * ("Interpolation", geometric or linear) times the closure's factor for g and b/R ("Closure"). */
@@ -112,54 +164,13 @@ static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLO
   float out[3];
   const int want_ratio = g != 0.0f && closure != MS_CACHE_CLOSURE_CAMERA; /* b/R read only for a closure */
   for (int ch = 0; ch < 3; ++ch) {
-    /* R geometrically ("Interpolation"), the moment per unit R linearly: from the node's ln R and
-     * b/R when every corner has R > 0 (the build stores them: no log or division here), else from
-     * the running means with R + floor. */
     vec3 ratio = vec3_splat(0.0f);
+    float R;
     switch (interpolation) {
-      case MS_CACHE_INTERPOLATION_GEOMETRIC: break;
-      case MS_CACHE_INTERPOLATION_LINEAR: { /* the running means mixed linearly ("Interpolation") */
-        float R = 0.0f;
-        for (int k = 0; k < 8; ++k) {
-          NV_GLOBAL const float* node = cache + at[k];
-          R += w[k] * node[ch];
-          if (want_ratio)
-            ratio = vec3_add(ratio, vec3_scale(vec3_make(node[4 + 4 * ch], node[5 + 4 * ch], node[6 + 4 * ch]), w[k]));
-        }
-        R = nv_fmax(R, 0.0f);
-        ratio = R > 0.0f ? vec3_scale(ratio, 1.0f / R) : vec3_splat(0.0f);
-        out[ch] = g != 0.0f ? ms_cache_closure(closure, R, g, ratio, w_out) : R;
-        continue;
-      }
-      default: out[ch] = 0.0f; continue; /* unknown: reported at the kernel's entry */
+      case MS_CACHE_INTERPOLATION_GEOMETRIC: R = ms_cache_mix_geometric(cache, at, w, ch, want_ratio, &ratio); break;
+      case MS_CACHE_INTERPOLATION_LINEAR: R = ms_cache_mix_linear(cache, at, w, ch, want_ratio, &ratio); break;
+      default: R = 0.0f; break; /* unknown: reported at the kernel's entry */
     }
-    int all_lit = 1;
-    for (int k = 0; k < 8; ++k) all_lit &= cache[at[k] + MS_CACHE_LOG_R + (size_t)ch] > -NV_INFINITY;
-    float log_r = 0.0f, floor = 0.0f;
-    if (all_lit) {
-      for (int k = 0; k < 8; ++k) {
-        log_r += w[k] * cache[at[k] + MS_CACHE_LOG_R + (size_t)ch];
-        if (want_ratio) {
-          NV_GLOBAL const float* q = cache + at[k] + MS_CACHE_RATIO + 3 * ch;
-          ratio = vec3_add(ratio, vec3_scale(vec3_make(q[0], q[1], q[2]), w[k]));
-        }
-      }
-    } else {
-      float top = 0.0f;
-      for (int k = 0; k < 8; ++k) top = nv_fmax(top, cache[at[k] + (size_t)ch]);
-      if (!(top > 0.0f)) {
-        out[ch] = 0.0f;
-        continue;
-      }
-      floor = MS_CACHE_LOG_FLOOR * top;
-      for (int k = 0; k < 8; ++k) {
-        NV_GLOBAL const float* node = cache + at[k];
-        const float r = nv_fmax(node[ch], 0.0f) + floor;
-        log_r += w[k] * nv_log(r);
-        ratio = vec3_add(ratio, vec3_scale(vec3_make(node[4 + 4 * ch], node[5 + 4 * ch], node[6 + 4 * ch]), w[k] / r));
-      }
-    }
-    const float R = nv_fmax(nv_exp(log_r) - floor, 0.0f);
     out[ch] = g != 0.0f ? ms_cache_closure(closure, R, g, ratio, w_out) : R;
   }
   return vec3_make(out[0], out[1], out[2]);
