@@ -13,6 +13,10 @@ parameters and sweeps (full mode; each sweep varies one parameter from the base)
   raymarch-cache-camera  the same with msCache.closure "camera" (the cache's paths aimed at the
                     camera): msCache.resolution 16,32; msCache.paths 256,1024; areaLightPhase points,exact;
                     msCache.interpolation geometric,linear
+  raymarch-cache-view    the cache laid out in view space (msCache.layout "view": columns over the
+                    image, nodes along their optical depth), the phase over rectangles exact and their
+                    shadows weighted by the phase: msCache.tile 2,4,8 (base 4); msCache.slices 4,8,16
+                    (base 8); msCache.paths 64,256,1024 (base 256); shadowWeighting area,phase (base phase)
   lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
   lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
 Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
@@ -101,6 +105,12 @@ METHODS = {
                               "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.closure": "camera"},
                               "base": {"msCache.resolution": 16, "msCache.paths": 256},
                               "style": ("square", "#66a61e")},
+    "raymarch-cache-view": {"algorithm": "raymarch",
+                            "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.layout": "view",
+                                         "areaLightPhase": "exact"},
+                            "base": {"msCache.tile": 4, "msCache.slices": 8, "msCache.paths": 256,
+                                     "shadowWeighting": "phase"},
+                            "style": ("diamond", "#e6ab02")},
     "lobe-eq7": {"algorithm": "lobe", "settings": {"variant": "eq7"}, "base": {}, "style": ("triangle", "#1b9e77")},
     "lobe-corrected": {"algorithm": "lobe", "settings": {"variant": "corrected"}, "base": {"viewSteps": 16},
                        "style": ("cross", "#7570b3")},
@@ -116,6 +126,8 @@ FULL_SWEEPS = {
                        "msCache.closure": ["linear", "hg"]},
     "raymarch-cache-camera": {"msCache.resolution": [16, 32], "msCache.paths": [256, 1024],
                               "areaLightPhase": ["points", "exact"], "msCache.interpolation": ["geometric", "linear"]},
+    "raymarch-cache-view": {"msCache.tile": [2, 4, 8], "msCache.slices": [4, 8, 16], "msCache.paths": [64, 256, 1024],
+                            "shadowWeighting": ["area", "phase"]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},
@@ -126,6 +138,7 @@ QUICK_SWEEPS = {
     "raymarch-octaves": {"octaves": [2, 4], "steps": [30, 60]},
     "raymarch-cache": {"msCache.resolution": [8, 16], "msCache.paths": [64, 256], "steps": [30, 60]},
     "raymarch-cache-camera": {"msCache.resolution": [8, 16], "msCache.paths": [64, 256]},
+    "raymarch-cache-view": {"msCache.tile": [4, 8], "msCache.paths": [16, 64]},
     "lobe-eq7": {"lobePoints": [10, 30], "depthFactor": [5, 100], "shadowSteps": [25, 100]},
     "lobe-corrected": {"lobePoints": [10, 30], "lobeRadius": [0.3, 3], "viewSteps": [8, 16]},
 }
@@ -134,7 +147,8 @@ QUICK_SWEEPS = {
 REALTIME_DEFAULTS = {
     "raymarch": {"steps": 60, "shadowSteps": 10, "octaves": 1, "msCache.resolution": 16, "msCache.paths": 256,
                  "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points", "msCache.closure": "linear",
-                 "msCache.interpolation": "geometric"},
+                 "msCache.interpolation": "geometric", "msCache.layout": "grid", "msCache.tile": 4,
+                 "msCache.slices": 8, "shadowWeighting": "area"},
     "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24,
              "areaLightPhase": "points"},
 }

@@ -14,6 +14,7 @@ __kernel void light_cache_build(KERNEL_SCENE_ARGS,
   KERNEL_CONTEXT_BEGIN(ctx);
   ctx.status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
   cache[(size_t)light * (size_t)nodes + (size_t)node] = light_cache_build_node(
-      KERNEL_ENTRY_ARG(ctx), c, params->shadow_steps, params->shadow_area_samples, &lights[light], node);
+      KERNEL_ENTRY_ARG(ctx), c, params->shadow_steps, params->shadow_area_samples, params->shadow_weighting,
+      &lights[light], node);
   if (ctx.status) atomic_or(status_word, ctx.status);
 }

@@ -12,9 +12,6 @@ __kernel void ms_cache_build(KERNEL_SCENE_ARGS,
   if (node >= node_grid_count(c)) return;
   KERNEL_CONTEXT_BEGIN(ctx);
   ctx.status = scene_kinds_status(scene, lights) | realtime_kinds_status(params); /* STATUS_UNKNOWN_KIND */
-  /* A node no lookup reads is left at 0 (ms_cache_node_is_read). */
-  if (ms_cache_node_is_read(KERNEL_ENTRY_ARG(ctx), c, node))
-    ms_cache_refine_node(KERNEL_ENTRY_ARG(ctx), c, params->ms_cache_closure, node,
-                         cache + (size_t)node * MS_CACHE_STRIDE, first, count);
+  ms_cache_build_node(KERNEL_ENTRY_ARG(ctx), params, node, cache + (size_t)node * MS_CACHE_STRIDE, first, count);
   if (ctx.status) atomic_or(status_word, ctx.status);
 }

@@ -86,6 +86,7 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"light_cache_builds", s.lightCacheBuilds},
           {"light_cache_ms", s.lightCacheMs},
           {"ms_cache_cells", {s.msCacheCells[0], s.msCacheCells[1], s.msCacheCells[2]}},
+          {"ms_cache_layout", s.msCacheView ? "view" : "grid"},
           {"ms_cache_paths", s.msCachePaths},
           {"ms_cache_builds", s.msCacheBuilds},
           {"ms_cache_ms", s.msCacheMs},
@@ -284,7 +285,7 @@ int runRender(const RenderArgs& a) {
               << s.lightCacheMs << " ms (not in the frame times)\n";
   if (s.msCacheBuilds > 0)
     report << "multiple-scattering cache: " << s.msCacheCells[0] << "x" << s.msCacheCells[1] << "x"
-              << s.msCacheCells[2] << " cells, " << s.msCachePaths << " paths per node in " << s.msCacheMs
+              << s.msCacheCells[2] << (s.msCacheView ? " columns x rows x slices, " : " cells, ") << s.msCachePaths << " paths per node in " << s.msCacheMs
               << " ms (not in the frame times)\n";
   report << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
             << s.algorithm << ", ";

@@ -28,7 +28,8 @@ std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view*
   for (int l = 0; l < ds.params.num_lights; ++l)
     for (int n = 0; n < nodes; ++n)
       cache[size_t(l) * size_t(nodes) + size_t(n)] =
-          light_cache_build_node(&ctx, &c, params.shadow_steps, params.shadow_area_samples, &ds.lights[size_t(l)], n);
+          light_cache_build_node(&ctx, &c, params.shadow_steps, params.shadow_area_samples, params.shadow_weighting,
+                                 &ds.lights[size_t(l)], n);
   return cache;
 }
 
@@ -42,7 +43,9 @@ void DeviceLightCache::update(ClRuntime& rt, const DeviceSceneBuffers& dev, cons
   // DeviceSceneBuffers keeps its grid for its life, and a new scene makes a new one.
   const std::string key = rawBytes(dev.scene.params.medium) + rawBytes(dev.scene.grid) + rawBytes(c) +
                           rawBytes(params.shadow_steps) + rawBytes(params.shadow_area_samples) + dev.buildOptions() +
-                          rawBytes(numLights);
+                          rawBytes(numLights) + rawBytes(params.shadow_weighting) +
+                          // weighted by the phase towards the camera: the camera too
+                          (params.shadow_weighting == SHADOW_WEIGHTING_PHASE ? rawBytes(dev.scene.params.camera) : "");
   const bool all = key != mediumKey_;
   if (all) {
     bytes_ = std::max<size_t>(1, nodes * size_t(numLights)) * sizeof(float);

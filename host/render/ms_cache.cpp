@@ -15,18 +15,20 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   if (c.nx <= 0) throw std::invalid_argument("DeviceMsCache::refine: the cache is off (nx = 0)");
   const size_t nodes = nodeGridCount(c);
   // The paths see the whole scene but the camera (medium, grid, lights, bounces, seed, background),
-  // and the camera too when they aim at it (MS_CACHE_CLOSURE_CAMERA: the cache starts over when it
-  // moves).
+  // and the camera too when they aim at it (MS_CACHE_CLOSURE_CAMERA, and always in the view layout:
+  // the cache starts over when it moves or the image changes size).
   const bool towardsCamera = params.ms_cache_closure == MS_CACHE_CLOSURE_CAMERA;
   scene_params pathScene = dev.scene.params;
   if (!towardsCamera) pathScene.camera = camera_params{};
   pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
   std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions() +
-                    (towardsCamera ? "camera" : "uniform");
+                    (towardsCamera ? "camera" : "uniform") + std::to_string(params.ms_cache_layout) + "/" +
+                    std::to_string(params.ms_cache_tile);
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
-    const AllocationSite site{sceneFile, "renderer.raymarch.msCache.resolution",
+    const bool view = params.ms_cache_layout == MS_CACHE_LAYOUT_VIEW;
+    const AllocationSite site{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
                                   "x" + std::to_string(c.nz) + " nodes"};
     buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site);

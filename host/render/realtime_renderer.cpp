@@ -50,13 +50,31 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
     case AreaLightPhase::Exact: p.area_light_phase = AREA_LIGHT_EXACT; break;
   }
   p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
-  if (!lobe && r.raymarch.multipleScattering == MultipleScattering::Cache)
-    p.ms_cache = nodeGridLayout(ds, r.raymarch.msCache.resolution);
-  switch (r.raymarch.msCache.closure) {
+  p.shadow_weighting = SHADOW_WEIGHTING_AREA;  // the lobe's, and the ray marcher's by default
+  if (!lobe && r.raymarch.shadowWeighting == ShadowWeighting::Phase) p.shadow_weighting = SHADOW_WEIGHTING_PHASE;
+  const MsCacheSettings& mc = r.raymarch.msCache;
+  const bool msCache = !lobe && r.raymarch.multipleScattering == MultipleScattering::Cache;
+  p.ms_cache_tile = mc.tile;
+  switch (mc.layout) {
+    case MsCacheLayout::Grid:
+      p.ms_cache_layout = MS_CACHE_LAYOUT_GRID;
+      if (msCache) p.ms_cache = nodeGridLayout(ds, mc.resolution);
+      break;
+    case MsCacheLayout::View:  // columns over the image, slices along them (ms_cache_view.h)
+      p.ms_cache_layout = MS_CACHE_LAYOUT_VIEW;
+      if (msCache && ds.params.has_medium) {
+        p.ms_cache.nx = (ds.params.camera.width + mc.tile - 1) / mc.tile;
+        p.ms_cache.ny = (ds.params.camera.height + mc.tile - 1) / mc.tile;
+        p.ms_cache.nz = mc.slices;
+      }
+      break;
+  }
+  switch (mc.closure) {
     case MsCacheClosure::Linear: p.ms_cache_closure = MS_CACHE_CLOSURE_LINEAR; break;
     case MsCacheClosure::Hg: p.ms_cache_closure = MS_CACHE_CLOSURE_HG; break;
     case MsCacheClosure::Camera: p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA; break;
   }
+  if (mc.layout == MsCacheLayout::View) p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA;  // its paths aim at the camera
   switch (r.raymarch.msCache.interpolation) {
     case MsCacheInterpolation::Geometric: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_GEOMETRIC; break;
     case MsCacheInterpolation::Linear: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_LINEAR; break;
@@ -180,7 +198,14 @@ RenderResult RealtimeRenderer::result() {
   st.msCacheMs = msCache_.buildMs();
   st.msCachePaths = msCache_.paths();
   st.msCacheBuilds = msCache_.rebuilds();
-  nodeGridCells(params_.ms_cache, st.msCacheCells);
+  st.msCacheView = params_.ms_cache_layout == MS_CACHE_LAYOUT_VIEW;
+  if (st.msCacheView) {  // its nodes are not cell corners: columns, rows, slices
+    st.msCacheCells[0] = params_.ms_cache.nx;
+    st.msCacheCells[1] = params_.ms_cache.ny;
+    st.msCacheCells[2] = params_.ms_cache.nz;
+  } else {
+    nodeGridCells(params_.ms_cache, st.msCacheCells);
+  }
   result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
   return result;
 }

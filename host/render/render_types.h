@@ -96,7 +96,9 @@ struct RenderStats {
   double lightCacheMs = 0;
   // raymarch with multipleScattering "cache" (render/ms_cache.h): cells per axis (0 0 0: off),
   // paths per node, times it was started (1), its build time apart from the frames.
+  // With layout "view" (msCacheView): columns, rows and slices instead of cells.
   int msCacheCells[3] = {0, 0, 0};
+  bool msCacheView = false;
   int msCachePaths = 0, msCacheBuilds = 0;
   double msCacheMs = 0;
 };

@@ -95,17 +95,28 @@ enum class MultipleScattering { None, Octaves, Cache };
 // dissertation's), or exactly over the light's solid angle (kernels/shared/phase_polygon.h).
 enum class AreaLightPhase { Points, Exact };
 
+// How a rectangle light's shadow averages its K×K points (kernels/shared/march.h,
+// march_light_column): by each point's share of the light reaching a point, or of the light it
+// scatters towards the camera (the phase function too; the light cache then follows the camera).
+enum class ShadowWeighting { Area, Phase };
+
 // What the cache's two moments (directional average R, first moment b) say about the
 // in-scattering in a direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear
 // expansion, or the HG lobe with those moments.
 enum class MsCacheClosure { Linear, Hg, Camera };
 // How the cache mixes its nodes (kernels/shared/ms_cache.h, "Interpolation").
 enum class MsCacheInterpolation { Geometric, Linear };
+// Where its nodes are: a grid over the medium's box, or columns over the image with nodes along
+// each column's optical depth from the camera (kernels/shared/ms_cache_view.h).
+enum class MsCacheLayout { Grid, View };
 
 struct MsCacheSettings {
   MsCacheClosure closure = MsCacheClosure::Linear;
   MsCacheInterpolation interpolation = MsCacheInterpolation::Geometric;
-  int resolution = 16;      // cells on the medium box's longest axis
+  MsCacheLayout layout = MsCacheLayout::Grid;
+  int resolution = 16;      // grid: cells on the medium box's longest axis
+  int tile = 4;             // view: pixels per column side
+  int slices = 8;           // view: nodes per column
   int paths = 256;          // paths per node
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
 };
@@ -132,6 +143,7 @@ struct RaymarchSettings {
   int areaLightSamples = 1;
   AreaLightPhase areaLightPhase = AreaLightPhase::Points;
   int shadowAreaSamples = 4;
+  ShadowWeighting shadowWeighting = ShadowWeighting::Area;
 };
 
 // Next-event estimation in the path tracer (kernels/shared/light_select.h): a shadow ray to every

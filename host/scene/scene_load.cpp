@@ -76,12 +76,19 @@
 // |                         | a rectangle light               |     |             | integral (phase_polygon.h) |
 // |   raymarch.shadowAreaSamples | integer: K×K points per    |     | 4           | [1, 16]; 1 = the centre    |
 // |                         | rectangle light (shadow)        |     |             |                            |
+// |   raymarch.shadowWeighting | area, phase: how a rectangle's|     | area        | phase: the light cache     |
+// |                         | shadow points are averaged      |     |             | follows the camera         |
 // |   raymarch.msCache.closure | linear, hg: the in-scattering  |     | linear      | ms_cache.h, "Closure";     |
 // |                         | its two moments give a direction;|    |             | camera: rebuilt when the   |
 // |                         | camera: estimated towards it    |     |             | camera moves               |
 // |   raymarch.msCache.interpolation | geometric, linear: how   |     | geometric   | ms_cache.h, "Interpolation"|
 // |                         | the nodes are mixed             |     |             |                            |
-// |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]                   |
+// |   raymarch.msCache.layout | grid, view: nodes over the     |     | grid        | view: aims at the camera   |
+// |                         | medium's box, or columns over   |     |             | (closure "camera"); rebuilt|
+// |                         | the image (ms_cache_view.h)     |     |             | when the camera moves      |
+// |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]; grid             |
+// |   raymarch.msCache.tile | integer: pixels per column side |     | 4           | [1, 256]; view             |
+// |   raymarch.msCache.slices | integer: nodes per column     |     | 8           | [2, 64]; view              |
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
 // |   lobe.variant          | eq7, corrected (lobe.h)         |     | eq7         |                            |
 // |   lobe.depthFactor      | number (eq7)                    |     | 20          | >= 0                       |
@@ -184,6 +191,9 @@ const EnumNames<MsCacheClosure> kMsCacheClosures = {
     {"linear", MsCacheClosure::Linear}, {"hg", MsCacheClosure::Hg}, {"camera", MsCacheClosure::Camera}};
 const EnumNames<MsCacheInterpolation> kMsCacheInterpolations = {{"geometric", MsCacheInterpolation::Geometric},
                                                                 {"linear", MsCacheInterpolation::Linear}};
+const EnumNames<ShadowWeighting> kShadowWeightings = {{"area", ShadowWeighting::Area},
+                                                      {"phase", ShadowWeighting::Phase}};
+const EnumNames<MsCacheLayout> kMsCacheLayouts = {{"grid", MsCacheLayout::Grid}, {"view", MsCacheLayout::View}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
 const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
                                           {"raymarch", Algorithm::Raymarch},
@@ -446,6 +456,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
     s.raymarch.areaLightSamples = readInt(m, "areaLightSamples", s.raymarch.areaLightSamples, 1, 16);
     s.raymarch.areaLightPhase = readAreaLightPhase(m, s.raymarch.areaLightPhase);
     s.raymarch.shadowAreaSamples = readInt(m, "shadowAreaSamples", s.raymarch.shadowAreaSamples, 1, 16);
+    s.raymarch.shadowWeighting = readEnum(m, "shadowWeighting", kShadowWeightings, s.raymarch.shadowWeighting);
     s.raymarch.multipleScattering =
         readEnum(m, "multipleScattering", kMultipleScattering,
                  s.raymarch.octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::None);
@@ -456,7 +467,18 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
       s.raymarch.msCache.closure = readEnum(mc, "closure", kMsCacheClosures, s.raymarch.msCache.closure);
       s.raymarch.msCache.interpolation =
           readEnum(mc, "interpolation", kMsCacheInterpolations, s.raymarch.msCache.interpolation);
+      s.raymarch.msCache.layout = readEnum(mc, "layout", kMsCacheLayouts, s.raymarch.msCache.layout);
+      if (s.raymarch.msCache.layout == MsCacheLayout::View && s.raymarch.msCache.closure != MsCacheClosure::Camera &&
+          mc.find("closure"))
+        ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
+      const bool view = s.raymarch.msCache.layout == MsCacheLayout::View;
+      for (const char* key : {"resolution", "interpolation", "tile", "slices"})
+        if (mc.find(key) && view != (std::string(key) == "tile" || std::string(key) == "slices"))
+          ctx.warn(mc.keyOf(key), std::string("applies to layout \"") + (view ? "grid" : "view") + "\"; \"" +
+                                      (view ? "view" : "grid") + "\" ignores it");
       s.raymarch.msCache.resolution = readInt(mc, "resolution", s.raymarch.msCache.resolution, 1, 256);
+      s.raymarch.msCache.tile = readInt(mc, "tile", s.raymarch.msCache.tile, 1, 256);
+      s.raymarch.msCache.slices = readInt(mc, "slices", s.raymarch.msCache.slices, 2, 64);
       s.raymarch.msCache.paths = readInt(mc, "paths", s.raymarch.msCache.paths, 1, 1 << 20);
       s.raymarch.msCache.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.raymarch.msCache.pathsPerLaunch, 1, 1 << 20);
       mc.reportUnknown();

@@ -37,11 +37,15 @@
  * Status word: STATUS_NAN for a NaN node point or column; STATUS_ITERATION_CAP from a DDA walk. */
 static inline float light_cache_build_node(KERNEL_CONTEXT_PARAM,
                                            NV_CONSTANT const node_grid_params* c, int shadow_steps, int K,
-                                           NV_CONSTANT const light_params* l, int node) {
+                                           int weighting, NV_CONSTANT const light_params* l, int node) {
   NV_CONSTANT const medium_params* m = ctx->medium;
   NV_PRIVATE uint* status = &ctx->status;
   const vec3 x = affine_point(c->index_to_world, node_grid_point(c, vec3_from4(m->dims), node));
-  const float column = march_light_column(KERNEL_CONTEXT_ARG, l, x, K, shadow_steps);
+  /* Weighted by the phase: towards the camera, along the view ray through the node. */
+  const vec3 from_camera = vec3_sub(x, vec3_from4(ctx->scene->camera.position));
+  const float d = vec3_length(from_camera);
+  const vec3 view_dir = d > 0.0f ? vec3_scale(from_camera, 1.0f / d) : vec3_from4(ctx->scene->camera.forward);
+  const float column = march_light_column(KERNEL_CONTEXT_ARG, l, x, K, shadow_steps, weighting, view_dir);
   if (column != column) *status |= STATUS_NAN; /* a NaN density on the way: said, not cached silently */
   return column;
 }
@@ -75,7 +79,7 @@ static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_CO
  * for every shadow ray. */
 static inline vec3 light_cache_optical_depth(KERNEL_CONTEXT_PARAM,
                                              NV_CONSTANT const realtime_params* rp, NV_GLOBAL const float* cache,
-                                             int light, vec3 x, vec3 dir, float dist) {
+                                             int light, vec3 x, vec3 dir, float dist, vec3 view_dir) {
   NV_CONSTANT const light_params* lights = ctx->lights;
   NV_CONSTANT const medium_params* m = ctx->medium;
   NV_PRIVATE uint* status = &ctx->status;
@@ -85,7 +89,7 @@ static inline vec3 light_cache_optical_depth(KERNEL_CONTEXT_PARAM,
   if (rp->shadow_area_samples > 1 && LIGHT_IS_RECT(&lights[light])) /* the columns the cache would hold */
     return vec3_scale(sigma_t_unit,
                       march_light_column(KERNEL_CONTEXT_ARG, &lights[light], x, rp->shadow_area_samples,
-                                         rp->shadow_steps));
+                                         rp->shadow_steps, rp->shadow_weighting, view_dir));
   return march_optical_depth(KERNEL_CONTEXT_ARG, x, dir, dist, rp->shadow_steps);
 }
 

@@ -182,7 +182,7 @@ static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
     float dist;
     if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
     const vec3 tr =
-        vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, p, light_cache, k, P, to_light, dist));
+        vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, p, light_cache, k, P, to_light, dist, d));
     if (p->area_light_samples > 1 || p->area_light_phase != AREA_LIGHT_POINTS) {
       /* rectangles as K×K points or integrated exactly (march_light_phase) */
       *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase(&lights[k], P, m->phase, m->g, d, p->area_light_phase,
@@ -333,11 +333,8 @@ static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtim
   /* L_b, and the view ray stops at the first rectangle it meets (rectangles are opaque). */
   const vec3 Lb = march_background(s, lights, origin, dir);
   if (!s->has_medium || p->lobe_points < 1) return Lb;
-  float t_surf;
-  int front = 0;
-  intersect_lights(lights, s->num_lights, origin, dir, 0.0f, -1, &t_surf, &front);
   medium_segment seg;
-  if (!medium_intersect(&s->medium, origin, dir, 0.0f, t_surf, &seg)) return Lb;
+  if (!march_view_segment(s, lights, origin, dir, &seg)) return Lb;
 
   /* 3. Frame (t, b, ω) from the camera's right vector; (t, b, ω) is right-handed. */
   vec3 tx, ty;

@@ -339,7 +339,7 @@ static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, 
  * for all channels (a grey medium) σt_unit·C gives each channel's averaged transmittance exactly;
  * for a coloured one it is the average for the mean σt. */
 static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const light_params* l,
-                                       vec3 x, int K, int shadow_steps) {
+                                       vec3 x, int K, int shadow_steps, int weighting, vec3 view_dir) {
   NV_CONSTANT const medium_params* m = ctx->medium;
   NV_PRIVATE uint* status = &ctx->status;
   int area = 0; /* a rectangle's K×K points, else the light's one point */
@@ -366,7 +366,12 @@ static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const l
       if (!area) return column;
       const float cos_l = -vec3_dot(dir, n);
       if (!(cos_l > 0.0f)) continue;
-      const float w = cos_l / d2;
+      float w = cos_l / d2;
+      switch (weighting) {
+        case SHADOW_WEIGHTING_AREA: break;
+        case SHADOW_WEIGHTING_PHASE: w *= phase_eval(m->phase, m->g, view_dir, dir); break;
+        default: w = 0.0f; break; /* unknown: reported at the kernel's entry */
+      }
       w_sum += w;
       loss_sum += w * nv_expm1(-sigma * column);
       column_sum += w * column;
@@ -389,6 +394,17 @@ static inline vec3 march_background(NV_CONSTANT const scene_params* s, NV_CONSTA
   const int hit = intersect_lights(lights, s->num_lights, origin, dir, 0.0f, -1, &t, &front);
   if (hit < 0) return vec3_from4(s->background);
   return front ? vec3_from4(lights[hit].radiance) : vec3_splat(0.0f);
+}
+
+/* The view ray's segment through the medium's box into *seg, stopped at the first rectangle light it
+ * meets (the medium behind an emitter is hidden by it: the path tracer's rule); 0 when there is none.
+ * The real-time kernels' view rays and the view-space cache's columns (ms_cache_view.h) start here. */
+static inline int march_view_segment(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
+                                     vec3 origin, vec3 dir, NV_PRIVATE medium_segment* seg) {
+  float t_surf;
+  int front = 0;
+  intersect_lights(lights, s->num_lights, origin, dir, 0.0f, -1, &t_surf, &front);
+  return medium_intersect(&s->medium, origin, dir, 0.0f, t_surf, seg);
 }
 
 #endif

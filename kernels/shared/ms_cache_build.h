@@ -4,6 +4,7 @@
 #define NARVAL_MS_CACHE_BUILD_H
 
 #include "shared/ms_cache.h"
+#include "shared/ms_cache_view.h"
 #include "shared/pathtrace.h"
 #include "shared/sampling.h"
 
@@ -31,13 +32,11 @@ static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int clo
   }
 }
 
-/* Path k's estimate at node `node`: the radiance of the rest arriving along a direction drawn by
- * ms_cache_direction, and the direction ω it looked along. */
-static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_grid_params* c, int closure, int node,
-                                 uint k, NV_PRIVATE vec3* omega) {
+/* Path k's estimate at node `node`, at world point x: the radiance of the rest arriving along a
+ * direction drawn by ms_cache_direction, and the direction ω it looked along. */
+static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, int closure, vec3 x, int node, uint k, NV_PRIVATE vec3* omega) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
-  const vec3 x = affine_point(c->index_to_world, node_grid_point(c, vec3_from4(s->medium.dims), node));
   rng_state rng = rng_init(s->seed + MS_CACHE_SEED_OFFSET, (uint)node, k);
   const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
   *omega = ms_cache_direction(s, closure, x, u1, u2);
@@ -76,13 +75,14 @@ static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
   return 0;
 }
 
-/* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"):
- * v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then ln R and b/R. */
-static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_grid_params* c, int closure,
-                                        int node, NV_GLOBAL float* v, uint first, uint count) {
+/* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"), the
+ * node at world point x: v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then
+ * ln R and b/R. */
+static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, int closure, vec3 x, int node, NV_GLOBAL float* v,
+                                        uint first, uint count) {
   for (uint k = first; k < first + count; ++k) {
     vec3 omega;
-    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, c, closure, node, k, &omega);
+    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, closure, x, node, k, &omega);
     const float n = (float)(k + 1u);
     const float Lc[3] = {L.x, L.y, L.z};
     const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */
@@ -97,6 +97,31 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
     const float R = v[ch];
     v[MS_CACHE_LOG_R + ch] = R > 0.0f ? nv_log(R) : -NV_INFINITY;
     for (int a = 0; a < 3; ++a) v[MS_CACHE_RATIO + 3 * ch + a] = R > 0.0f ? v[4 + 4 * ch + a] / R : 0.0f;
+  }
+}
+
+
+/* One launch's work for node `node` (ms_cache.cl): paths [first, first + count) at the node's point,
+ * for the cache's layout. A grid node no lookup reads is left at 0 (ms_cache_node_is_read); a view
+ * node stores its optical depth, and no paths when its column holds no medium (ms_cache_view.h). */
+static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
+                                       NV_GLOBAL float* v, uint first, uint count) {
+  NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
+  switch (rp->ms_cache_layout) {
+    case MS_CACHE_LAYOUT_GRID:
+      if (ms_cache_node_is_read(KERNEL_CONTEXT_ARG, c, node))
+        ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp->ms_cache_closure,
+                             affine_point(c->index_to_world, node_grid_point(c, vec3_from4(ctx->medium->dims), node)),
+                             node, v, first, count);
+      return;
+    case MS_CACHE_LAYOUT_VIEW: {
+      float tau;
+      const vec3 x = ms_view_node_point(KERNEL_CONTEXT_ARG, rp, node, &tau);
+      v[MS_VIEW_TAU] = tau;
+      if (tau >= 0.0f) ms_cache_refine_node(KERNEL_CONTEXT_ARG, MS_CACHE_CLOSURE_CAMERA, x, node, v, first, count);
+      return;
+    }
+    default: return; /* unknown: reported at the kernel's entry */
   }
 }
 

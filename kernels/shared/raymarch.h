@@ -78,6 +78,7 @@
 #include "shared/camera.h"
 #include "shared/light_cache.h"
 #include "shared/ms_cache.h"
+#include "shared/ms_cache_view.h"
 #include "shared/phase.h"
 
 /* Light arriving at x and scattered towards the camera, per unit σs: Σ_lights (I/d²) ⊙
@@ -92,7 +93,7 @@ static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
     vec3 dir, I;
     float dist;
     if (!march_light_as_point(&lights[l], x, &dir, &dist, &I)) continue;
-    const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, rp, light_cache, l, x, dir, dist);
+    const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, rp, light_cache, l, x, dir, dist, view_dir);
     if (rp->area_light_samples > 1 || rp->area_light_phase != AREA_LIGHT_POINTS) {
       /* Rectangles as K×K points or integrated exactly (march_light_phase), one shadow for all. */
       const int K = rp->area_light_samples, mode = rp->area_light_phase;
@@ -132,23 +133,40 @@ typedef struct raymarch_accum {
   vec3 L, T;
 } raymarch_accum;
 
+/* The multiple-scattering cache's in-scattering towards the camera per unit σs at sample point x
+ * (world; p in index space), at grey optical depth tau from the camera along the view ray, for the
+ * pixel whose view-space columns are `cols` (ms_cache.h for the grid layout, ms_cache_view.h for the
+ * view layout). */
+static inline vec3 raymarch_ms_cache(NV_CONSTANT const realtime_params* rp, NV_CONSTANT const medium_params* m,
+                                     NV_GLOBAL const float* ms_cache, NV_PRIVATE const ms_view_columns* cols, vec3 p,
+                                     float tau, vec3 dir) {
+  switch (rp->ms_cache_layout) {
+    case MS_CACHE_LAYOUT_GRID:
+      return ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), p, phase_mean_cosine(m->phase, m->g),
+                             rp->ms_cache_closure, rp->ms_cache_interpolation, vec3_scale(dir, -1.0f));
+    case MS_CACHE_LAYOUT_VIEW: return ms_view_lookup(&rp->ms_cache, ms_cache, cols, tau);
+    default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
+  }
+}
+
 /* Marches the view ray origin + t·dir over its box segment `seg` in `steps` steps of equal true
  * length spread over the occupied cells (march_iter: empty cells are skipped), sampled at their
  * midpoints; stops once every channel of T is below t_stop (0: never; see "Early termination").
+ * `cols`: the pixel's columns of a view-space multiple-scattering cache (ms_cache_view.h).
  * Loops: `steps` samples (march_next, its piece walk capped by the DDA budget), each
  * with num_lights shadow marches of shadow_steps samples and `octaves` (≤ 16) terms: all bounded by
  * the scene's own parameters, no cap of their own. */
 static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp,
                                     NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache,
-                                    NV_PRIVATE const medium_segment* seg, vec3 origin, vec3 dir, int steps,
-                                    float t_stop, NV_PRIVATE raymarch_accum* acc) {
+                                    NV_PRIVATE const medium_segment* seg, NV_PRIVATE const ms_view_columns* cols,
+                                    vec3 origin, vec3 dir, int steps, float t_stop, NV_PRIVATE raymarch_accum* acc) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 sa = vec3_from4(m->sigma_a), ss = vec3_from4(m->sigma_s);
   march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, steps);
-  const float dt = it.delta;
-  float t;
+  const float dt = it.delta, sigma_grey = ms_view_sigma_t(m);
+  float t, tau = 0.0f; /* grey optical depth from the camera, for the view-space cache */
   while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
     const float rho = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t));
     if (!(rho > 0.0f)) { /* S = 0 and e^{−0} = 1: the step would change nothing */
@@ -157,16 +175,15 @@ static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const real
     }
     const vec3 sigma_t = vec3_scale(vec3_add(sa, ss), rho); /* as march_sigma_t */
     const vec3 sigma_s = vec3_scale(ss, rho);
+    const float dtau = sigma_grey * rho * dt;
     vec3 S = vec3_splat(0.0f);
     if (!vec3_is_zero(sigma_s)) {
       vec3 Li = raymarch_light_sum(KERNEL_CONTEXT_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir);
-      if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h) */
-        Li = vec3_add(Li, ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), vec3_madd(seg->o, seg->d, t),
-                                          phase_mean_cosine(m->phase, m->g), rp->ms_cache_closure,
-                                          rp->ms_cache_interpolation,
-                                          vec3_scale(dir, -1.0f)));
+      if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h), at the step's middle */
+        Li = vec3_add(Li, raymarch_ms_cache(rp, m, ms_cache, cols, vec3_madd(seg->o, seg->d, t), tau + 0.5f * dtau, dir));
       S = vec3_mul(sigma_s, Li);
     }
+    tau += dtau;
 #ifdef EMISSION
     S = vec3_add(S, emission_source(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t), rho)); /* σa·Le (emission.h) */
 #endif
@@ -186,17 +203,15 @@ static inline vec3 raymarch_pixel(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realti
   const vec3 Lb = march_background(s, lights, r.origin, r.dir);
   vec3 L = Lb;
   if (s->has_medium) {
-    /* The medium behind the emitter the ray hits is hidden by it (the path tracer's rule). */
-    float t_surf;
-    int front = 0;
-    intersect_lights(lights, s->num_lights, r.origin, r.dir, 0.0f, -1, &t_surf, &front);
     medium_segment seg;
-    if (medium_intersect(&s->medium, r.origin, r.dir, 0.0f, t_surf, &seg)) {
+    if (march_view_segment(s, lights, r.origin, r.dir, &seg)) {
       raymarch_accum acc;
       acc.L = vec3_splat(0.0f);
       acc.T = vec3_splat(1.0f);
       const float t_stop = rp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb));
-      raymarch_segment(KERNEL_CONTEXT_ARG, rp, light_cache, ms_cache, &seg, r.origin, r.dir, rp->steps, t_stop, &acc);
+      const ms_view_columns cols = ms_view_locate(rp, px, py);
+      raymarch_segment(KERNEL_CONTEXT_ARG, rp, light_cache, ms_cache, &seg, &cols, r.origin, r.dir, rp->steps, t_stop,
+                       &acc);
       L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
     }
   }

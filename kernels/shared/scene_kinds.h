@@ -62,6 +62,16 @@ static inline uint realtime_kinds_status(NV_CONSTANT const realtime_params* rp) 
     case MS_CACHE_INTERPOLATION_LINEAR: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
+  switch (rp->shadow_weighting) {
+    case SHADOW_WEIGHTING_AREA:
+    case SHADOW_WEIGHTING_PHASE: break;
+    default: status |= STATUS_UNKNOWN_KIND;
+  }
+  switch (rp->ms_cache_layout) {
+    case MS_CACHE_LAYOUT_GRID:
+    case MS_CACHE_LAYOUT_VIEW: break;
+    default: status |= STATUS_UNKNOWN_KIND;
+  }
   switch (rp->lobe_variant) {
     case LOBE_EQ7:
     case LOBE_CORRECTED: break;

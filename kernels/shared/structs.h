@@ -136,6 +136,17 @@ typedef struct node_grid_params {
 #define MS_CACHE_INTERPOLATION_GEOMETRIC 0
 #define MS_CACHE_INTERPOLATION_LINEAR 1
 
+/* How a rectangle light's shadow averages its K×K points (march_light_column): by each point's share
+ * of the light reaching x (cos θ/d²), or (PHASE) of the light x scatters towards the camera
+ * (p(θ)·cos θ/d², the phase for the direction from the camera to x). */
+#define SHADOW_WEIGHTING_AREA 0
+#define SHADOW_WEIGHTING_PHASE 1
+
+/* Where the multiple-scattering cache's nodes are (ms_cache.h; ms_cache_view.h): a grid over the
+ * medium's box, or columns over the image with nodes along each column's camera optical depth. */
+#define MS_CACHE_LAYOUT_GRID 0
+#define MS_CACHE_LAYOUT_VIEW 1
+
 /* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
 typedef struct realtime_params {
   int steps;            /* raymarch: samples over the view ray's segment; lobe: first-hit search samples */
@@ -157,9 +168,9 @@ typedef struct realtime_params {
   int area_light_phase;     /* AREA_LIGHT_POINTS (area_light_samples) or AREA_LIGHT_EXACT (march_light_phase) */
   int ms_cache_closure;     /* raymarch: MS_CACHE_CLOSURE_LINEAR, _HG or _CAMERA (ms_cache.h, "Closure") */
   int ms_cache_interpolation; /* raymarch: MS_CACHE_INTERPOLATION_GEOMETRIC or _LINEAR ("Interpolation") */
-  int pad0;
-  int pad1;
-  int pad2;
+  int ms_cache_layout;      /* raymarch: MS_CACHE_LAYOUT_GRID or _VIEW (ms_cache_view.h) */
+  int ms_cache_tile;        /* MS_CACHE_LAYOUT_VIEW: pixels per column side (ms_cache.nx, ny columns) */
+  int shadow_weighting;     /* raymarch: SHADOW_WEIGHTING_AREA or _PHASE (march_light_column) */
 } realtime_params;
 
 typedef struct scene_params {

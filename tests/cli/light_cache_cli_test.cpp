@@ -77,6 +77,25 @@ TEST_F(LightCacheCli, TheMultipleScatteringCacheIsBuiltOnceAndReported) {
   EXPECT_GT(sumCached, sumPlain);  // light scattered more than once only adds
 }
 
+// The view layout: columns of 4x4 pixels over the 24x18 image (6 x 5, the last row 2 pixels tall),
+// 8 slices by default, reported as such; a key of the other layout is named in one warning.
+TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
+  const RunResult r = run("render s.json -o v.exr --stats-json v.json --set "
+                          "renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\" "
+                          "--set renderer.raymarch.msCache.paths=4 --set renderer.raymarch.msCache.resolution=8");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "narval: warning: s.json: renderer.raymarch.msCache.resolution: applies to layout \"grid\"; "
+                   "\"view\" ignores it\n");
+  const nlohmann::json s = stats("v.json");
+  EXPECT_EQ(s["ms_cache_cells"], nlohmann::json::array({6, 5, 8}));
+  EXPECT_EQ(s["ms_cache_layout"], "view");
+  EXPECT_EQ(s["ms_cache_paths"], 4);
+  EXPECT_EQ(s["nan_pixels"], 0);
+  EXPECT_NE(r.out.find("\nmultiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node in "),
+            std::string::npos)
+      << r.out;
+}
+
 // Moving the point light is a new cache: the image changes where its light reaches the cloud.
 TEST_F(LightCacheCli, MovingALightChangesTheImage) {
   ASSERT_EQ(run("render s.json -o a.exr --stats-json a.json").code, 0);
@@ -136,6 +155,16 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.msCache.interpolation: unknown value \"cubic\" (allowed: geometric, linear)\n"},
       {"renderer.raymarch.msCache.resolution=0",
        "narval: s.json: renderer.raymarch.msCache.resolution: must be at least 1, got 0\n"},
+      {"renderer.raymarch.msCache.layout=\\\"froxels\\\"",
+       "narval: s.json: renderer.raymarch.msCache.layout: unknown value \"froxels\" (allowed: grid, view)\n"},
+      {"renderer.raymarch.shadowWeighting=\\\"cosine\\\"",
+       "narval: s.json: renderer.raymarch.shadowWeighting: unknown value \"cosine\" (allowed: area, phase)\n"},
+      {"renderer.raymarch.msCache.tile=0", "narval: s.json: renderer.raymarch.msCache.tile: must be at least 1, got 0\n"},
+      {"renderer.raymarch.msCache.slices=1",
+       "narval: s.json: renderer.raymarch.msCache.slices: must be at least 2, got 1\n"},
+      {"renderer.raymarch.msCache.closure=\\\"hg\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",
+       "narval: s.json: renderer.raymarch.msCache.closure: must be \"camera\" with layout \"view\" (its paths aim at "
+       "the camera)\n"},
       {"renderer.raymarch.shadowAreaSamples=0",
        "narval: s.json: renderer.raymarch.shadowAreaSamples: must be at least 1, got 0\n"},
       {"renderer.raymarch.areaLightSamples=17",

@@ -584,6 +584,16 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
   EXPECT_EQ(probe()[0], 0u);
   rp.ms_cache_interpolation = 2;
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
+  rp.ms_cache_interpolation = MS_CACHE_INTERPOLATION_LINEAR;
+  rp.ms_cache_layout = MS_CACHE_LAYOUT_VIEW;
+  EXPECT_EQ(probe()[0], 0u);
+  rp.ms_cache_layout = 2;
+  EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
+  rp.ms_cache_layout = MS_CACHE_LAYOUT_GRID;
+  rp.shadow_weighting = SHADOW_WEIGHTING_PHASE;
+  EXPECT_EQ(probe()[0], 0u);
+  rp.shadow_weighting = 2;
+  EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
 }
 
 }  // namespace

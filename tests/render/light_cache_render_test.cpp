@@ -124,28 +124,34 @@ TEST(LightCacheRender, AutomaticCacheOnACloudStaysWithinOneDeltaEOfExactMarching
 }
 
 // The device builds what the host's shared header computes (same quadrature and arithmetic; no
-// contraction into FMA on either side, compat.h): within 1e-6 relative.
+// contraction into FMA on either side, compat.h): within 1e-6 relative. Both weightings of a
+// rectangle's shadow points (march_light_column): by area, and by the phase towards the camera.
 TEST(LightCacheRender, DeviceBuildMatchesTheHost) {
-  const DenseGrid cloud = makeCloud(24, 5);
-  const Scene scene = sceneFromJson(litCloudJson(R"({"resolution": [8, 8], "algorithm": "raymarch", "storage": "buffer",
-                                                     "lightCache": {"resolution": 20}})"));
-  DeviceSceneBuffers dev(runtime(), scene, &cloud);
-  const realtime_params params = realtimeParams(scene, dev.scene);
-  DeviceLightCache cache;
-  cache.update(runtime(), dev, params, scene.sourcePath);
-  const grid_view gv{cloud.data.data(), cloud.nx, cloud.ny, cloud.nz, dev.scene.majorants.data()};
-  const std::vector<float> host = buildLightCacheOnHost(dev.scene, &gv, params);
-  std::vector<float> device(host.size());
-  runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, device.size() * sizeof(float), device.data());
-  int positive = 0;
-  for (size_t i = 0; i < host.size(); ++i) {
-    // A rectangle's column is −log1p(mean of expm1(−σ̄C_j))/σ̄ over its K×K points: OpenCL's expm1
-    // and log1p may differ from libm's by a few ulps, which that quotient carries to ~1e-6 relative.
-    ASSERT_NEAR(device[i], host[i], 1e-5 * host[i] + 1e-9) << "value " << i;
-    positive += host[i] > 0;
+  for (const char* weighting : {"area", "phase"}) {
+    SCOPED_TRACE(weighting);
+    const DenseGrid cloud = makeCloud(24, 5);
+    const Scene scene = sceneFromJson(litCloudJson(R"({"resolution": [8, 8], "algorithm": "raymarch", "storage": "buffer",
+                                                       "lightCache": {"resolution": 20},
+                                                       "raymarch": {"shadowWeighting": ")" + std::string(weighting) + R"("}})"));
+    DeviceSceneBuffers dev(runtime(), scene, &cloud);
+    const realtime_params params = realtimeParams(scene, dev.scene);
+    EXPECT_EQ(params.shadow_weighting, std::string(weighting) == "phase" ? SHADOW_WEIGHTING_PHASE : SHADOW_WEIGHTING_AREA);
+    DeviceLightCache cache;
+    cache.update(runtime(), dev, params, scene.sourcePath);
+    const grid_view gv{cloud.data.data(), cloud.nx, cloud.ny, cloud.nz, dev.scene.majorants.data()};
+    const std::vector<float> host = buildLightCacheOnHost(dev.scene, &gv, params);
+    std::vector<float> device(host.size());
+    runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, device.size() * sizeof(float), device.data());
+    int positive = 0;
+    for (size_t i = 0; i < host.size(); ++i) {
+      // A rectangle's column is −log1p(mean of expm1(−σ̄C_j))/σ̄ over its K×K points: OpenCL's expm1
+      // and log1p may differ from libm's by a few ulps, which that quotient carries to ~1e-6 relative.
+      ASSERT_NEAR(device[i], host[i], 1e-5 * host[i] + 1e-9) << "value " << i;
+      positive += host[i] > 0;
+    }
+    EXPECT_GT(positive, int(host.size()) / 4);  // the cloud shadows a good part of the box
+    EXPECT_EQ(cache.status(), 0u);
   }
-  EXPECT_GT(positive, int(host.size()) / 4);  // the cloud shadows a good part of the box
-  EXPECT_EQ(cache.status(), 0u);
 }
 
 // The build kernel's status word is live: a NaN voxel (the loaders refuse them; a grid handed over
@@ -169,7 +175,8 @@ TEST(LightCacheRender, ANanVoxelRaisesTheBuildsStatus) {
 
 // Rebuilt only when the medium, that light or the shadow quadrature changes: update() on the same
 // scene or after a camera move builds nothing; moving one light rebuilds its slab alone; another
-// density or step count rebuilds every slab.
+// density or step count rebuilds every slab. Weighted by the phase towards the camera, the shadow
+// depends on the camera: the weighting itself, and then a camera move, rebuild every slab.
 TEST(LightCacheRender, RebuildsOnlyTheSlabsWhoseInputsChanged) {
   const DenseGrid cloud = makeCloud(16, 2);
   auto scene = [](const std::string& renderer, double density = 4) {
@@ -208,6 +215,18 @@ TEST(LightCacheRender, RebuildsOnlyTheSlabsWhoseInputsChanged) {
   moreSteps.shadow_steps += 1;
   cache.update(runtime(), devDenser, moreSteps, "denser");
   EXPECT_EQ(cache.slabsBuilt(), 7);
+
+  realtime_params phase = moreSteps;
+  phase.shadow_weighting = SHADOW_WEIGHTING_PHASE;
+  cache.update(runtime(), devDenser, phase, "denser");
+  EXPECT_EQ(cache.slabsBuilt(), 9);
+  cache.update(runtime(), devDenser, phase, "denser");
+  EXPECT_EQ(cache.slabsBuilt(), 9);
+  Scene denserMoved = denser;
+  denserMoved.camera.position = {1.0f, 0.5f, -6.0f};
+  DeviceSceneBuffers devDenserMoved(runtime(), denserMoved, &cloud);
+  cache.update(runtime(), devDenserMoved, phase, "denser");
+  EXPECT_EQ(cache.slabsBuilt(), 11);
 }
 
 // Early termination (minTransmittance ε): the ray marcher stops once every channel of T is below

@@ -225,7 +225,7 @@ TEST(LightCache, EmptyGridGivesTransmittanceOneExactly) {
     ASSERT_TRUE(march_light_as_point(&c.ds.lights[0], p, &dir, &dist, &I));
     const vec3 tr = vec3_exp_neg(
         light_cache_optical_depth(narval::test::sceneContext(&c.ds.params, c.ds.lights.data(), &c.grid, &status),
-                                  &params, c.slabs.data(), 0, p, dir, dist));
+                                  &params, c.slabs.data(), 0, p, dir, dist, vec3_make(0, 0, 1)));
     ASSERT_EQ(tr.x, 1.0f);
     ASSERT_EQ(tr.y, 1.0f);
     ASSERT_EQ(tr.z, 1.0f);
