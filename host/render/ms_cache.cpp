@@ -23,7 +23,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
   std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions() +
                     (towardsCamera ? "camera" : "uniform") + std::to_string(params.ms_cache_layout) + "/" +
-                    std::to_string(params.ms_cache_tile);
+                    std::to_string(params.ms_cache_tile) + (params.ms_cache_direct ? "/direct" : "");
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);

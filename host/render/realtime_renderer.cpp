@@ -75,6 +75,8 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
     case MsCacheClosure::Camera: p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA; break;
   }
   if (mc.layout == MsCacheLayout::View) p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA;  // its paths aim at the camera
+  p.ms_cache_direct = msCache && mc.direct;
+  if (p.ms_cache_direct) p.light_cache = node_grid_params{};  // no light loop: no shadow rays to cache
   switch (r.raymarch.msCache.interpolation) {
     case MsCacheInterpolation::Geometric: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_GEOMETRIC; break;
     case MsCacheInterpolation::Linear: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_LINEAR; break;

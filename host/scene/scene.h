@@ -117,6 +117,9 @@ struct MsCacheSettings {
   int resolution = 16;      // grid: cells on the medium box's longest axis
   int tile = 4;             // view: pixels per column side
   int slices = 8;           // view: nodes per column
+  // The lights' unscattered light: added by the march (false) or held by the cache with the rest
+  // (kernels/shared/ms_cache.h, "Direct"; closure "camera" or layout "view" only).
+  bool direct = false;
   int paths = 256;          // paths per node
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
 };

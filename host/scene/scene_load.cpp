@@ -87,6 +87,8 @@
 // |                         | medium's box, or columns over   |     |             | (closure "camera"); rebuilt|
 // |                         | the image (ms_cache_view.h)     |     |             | when the camera moves      |
 // |   raymarch.msCache.resolution | integer: cells, longest axis |  | 16          | [1, 256]; grid             |
+// |   raymarch.msCache.direct | boolean: the cache holds the  |     | false       | closure camera or layout   |
+// |                         | lights' unscattered light too   |     |             | view; no light loop        |
 // |   raymarch.msCache.tile | integer: pixels per column side |     | 4           | [1, 256]; view             |
 // |   raymarch.msCache.slices | integer: nodes per column     |     | 8           | [2, 64]; view              |
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
@@ -478,6 +480,10 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
                                       (view ? "view" : "grid") + "\" ignores it");
       s.raymarch.msCache.resolution = readInt(mc, "resolution", s.raymarch.msCache.resolution, 1, 256);
       s.raymarch.msCache.tile = readInt(mc, "tile", s.raymarch.msCache.tile, 1, 256);
+      s.raymarch.msCache.direct = mc.getBool("direct", s.raymarch.msCache.direct);
+      if (s.raymarch.msCache.direct && !view && s.raymarch.msCache.closure != MsCacheClosure::Camera)
+        ctx.fail(mc.keyOf("direct"), "needs closure \"camera\" or layout \"view\" (a node must hold the light "
+                                     "scattered towards the camera)");
       s.raymarch.msCache.slices = readInt(mc, "slices", s.raymarch.msCache.slices, 2, 64);
       s.raymarch.msCache.paths = readInt(mc, "paths", s.raymarch.msCache.paths, 1, 1 << 20);
       s.raymarch.msCache.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.raymarch.msCache.pathsPerLaunch, 1, 1 << 20);
@@ -621,6 +627,13 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
   bool emits = false;
   for (const Material& m : scene.materials) emits = emits || m.emission.kind != EmissionKind::None;
   scene.renderer = readRenderer(ctx, root.require("renderer"), "renderer", emits);
+  // A cache holding the lights' unscattered light gets it from paths that meet the light: a point
+  // light is never met (kernels/shared/ms_cache.h, "Direct").
+  if (scene.renderer.raymarch.msCache.direct)
+    for (const Primitive& p : scene.primitives)
+      if (p.type == PrimitiveType::Point)
+        ctx.fail("renderer.raymarch.msCache.direct", "needs rectangle lights: point light \"" + p.name +
+                                                         "\" is never met by the cache's paths");
   scene.background = root.getVec3("background", scene.background);
   checkNonNegative(ctx, "background", scene.background);
   root.reportUnknown();

@@ -329,6 +329,61 @@ static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, 
   }
 }
 
+/* A rectangle's effective column weighted by the phase towards the camera (SHADOW_WEIGHTING_PHASE):
+ * T̄ = ∫ p(view_dir·ω) T(ω) dω / ∫ p(view_dir·ω) dω over the light's solid angle, so that
+ * Le·T̄·∫ p dω (march_light_phase) is the single scattering ∫ Le p T dω whenever the phase and the
+ * shadow vary together. They do behind a cloud lit from the back: at g 0.9 the phase is a peak a
+ * few degrees wide around the view ray's continuation, the shadow along it is the thin rim's, and
+ * an average over the light's area (the other weighting) takes in directions through the cloud's
+ * body (bench/RESULTS.md: the back-lit Disney cloud's rim 25% dark, its core 3x bright). Both
+ * integrals are estimated by two strategies combined with the balance heuristic (Veach 1997,
+ * ch. 9): the K×K points of march_light_area_point (the area's midpoint rule: a solid-angle pdf of
+ * d²/(A·cos θ_l)), and K×K directions drawn from the phase function about view_dir on a regular
+ * grid of its two numbers (pdf p), those that meet the light's front. The first serves broad
+ * phases and lights far off the view direction, the second the peak, however narrow. A sample of
+ * either is weighted by p/(n·pdf_area + n·p), n = K², in both the numerator (times T) and the
+ * denominator, so the ratio is exact for a shadow constant over the light and converges as K grows.
+ * Deterministic: fixed patterns, no random numbers. Returns −ln T̄/σ̄ as march_light_column. */
+static inline float march_light_column_phase(KERNEL_CONTEXT_PARAM, NV_CONSTANT const light_params* l, vec3 x, int K,
+                                             int shadow_steps, vec3 view_dir) {
+  NV_CONSTANT const medium_params* m = ctx->medium;
+  const vec3 nrm = vec3_from4(l->normal);
+  const float area = l->normal.w, n = (float)(K * K);
+  const float sigma = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  float w_sum = 0.0f, loss_sum = 0.0f, column_sum = 0.0f; /* as march_light_column */
+  for (int strategy = 0; strategy < 2; ++strategy)
+    for (int j = 0; j < K; ++j)
+      for (int i = 0; i < K; ++i) {
+        vec3 dir;
+        float d;
+        if (strategy == 0) { /* the area's point (i, j) */
+          const vec3 to = vec3_sub(march_light_area_point(l, i, j, K), x);
+          d = vec3_length(to);
+          if (!(d > 0.0f)) continue;
+          dir = vec3_scale(to, 1.0f / d);
+        } else { /* the phase's direction (i, j) */
+          float pdf;
+          int front = 0;
+          dir = phase_sample(m->phase, m->g, view_dir, ((float)i + 0.5f) / (float)K, ((float)j + 0.5f) / (float)K, &pdf);
+          d = intersect_rectangle(l, x, dir, 0.0f, &front);
+          if (!(d < NV_INFINITY) || !front) continue;
+        }
+        const float cos_l = -vec3_dot(dir, nrm);
+        if (!(cos_l > 0.0f)) continue;
+        const float p = phase_eval(m->phase, m->g, view_dir, dir);
+        const float w = p / (n * d * d / (area * cos_l) + n * p);
+        if (!(w > 0.0f)) continue;
+        const float column = march_column_density(KERNEL_CONTEXT_ARG, x, dir, d, shadow_steps);
+        w_sum += w;
+        loss_sum += w * nv_expm1(-sigma * column);
+        column_sum += w * column;
+      }
+  if (!(w_sum > 0.0f)) return 0.0f;
+  const float mean_loss = loss_sum / w_sum;
+  if (!(sigma > 0.0f) || !(mean_loss > -1.0f)) return column_sum / w_sum;
+  return -nv_log1p(mean_loss) / sigma;
+}
+
 /* Column density from x to light l, ∫ρ ds over shadow_steps midpoint samples: to the light itself
  * (a point light; a rectangle with K = 1: its centre), or for a rectangle with K > 1 the effective
  * column of its K×K points (march_light_phase_sum's): C = −ln(Σ_j w_j e^{−σ̄ C_j} / Σ_j w_j) / σ̄,
@@ -337,7 +392,8 @@ static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, 
  * transmittance averaged over them is above the transmittance to the centre (e^{−τ} is convex):
  * through a dense cloud the centre alone makes the light's soft shadow hard and dark. With one σt
  * for all channels (a grey medium) σt_unit·C gives each channel's averaged transmittance exactly;
- * for a coloured one it is the average for the mean σt. */
+ * for a coloured one it is the average for the mean σt. `weighting` SHADOW_WEIGHTING_PHASE weights a
+ * rectangle's shadow by the phase for view_dir instead (march_light_column_phase). */
 static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const light_params* l,
                                        vec3 x, int K, int shadow_steps, int weighting, vec3 view_dir) {
   NV_CONSTANT const medium_params* m = ctx->medium;
@@ -347,6 +403,13 @@ static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const l
     case LIGHT_RECTANGLE: area = K > 1; break;
     case LIGHT_POINT: break;
     default: return 0.0f; /* unknown: sends nothing (march_light_as_point), reported at the entry */
+  }
+  switch (weighting) {
+    case SHADOW_WEIGHTING_AREA: break;
+    case SHADOW_WEIGHTING_PHASE:
+      if (area) return march_light_column_phase(KERNEL_CONTEXT_ARG, l, x, K, shadow_steps, view_dir);
+      break; /* one point: nothing to weight */
+    default: return 0.0f; /* unknown: reported at the kernel's entry */
   }
   const vec3 n = vec3_from4(l->normal);
   const int k_side = area ? K : 1;
@@ -366,12 +429,7 @@ static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const l
       if (!area) return column;
       const float cos_l = -vec3_dot(dir, n);
       if (!(cos_l > 0.0f)) continue;
-      float w = cos_l / d2;
-      switch (weighting) {
-        case SHADOW_WEIGHTING_AREA: break;
-        case SHADOW_WEIGHTING_PHASE: w *= phase_eval(m->phase, m->g, view_dir, dir); break;
-        default: w = 0.0f; break; /* unknown: reported at the kernel's entry */
-      }
+      const float w = cos_l / d2;
       w_sum += w;
       loss_sum += w * nv_expm1(-sigma * column);
       column_sum += w * column;

@@ -34,13 +34,14 @@ static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int clo
 
 /* Path k's estimate at node `node`, at world point x: the radiance of the rest arriving along a
  * direction drawn by ms_cache_direction, and the direction ω it looked along. */
-static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, int closure, vec3 x, int node, uint k, NV_PRIVATE vec3* omega) {
+static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, int closure, int direct, vec3 x, int node, uint k,
+                                 NV_PRIVATE vec3* omega) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
   rng_state rng = rng_init(s->seed + MS_CACHE_SEED_OFFSET, (uint)node, k);
   const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
   *omega = ms_cache_direction(s, closure, x, u1, u2);
-  const vec3 L = pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, 0, &rng);
+  const vec3 L = pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, &rng); /* ms_cache.h, "Direct" */
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);
@@ -78,11 +79,11 @@ static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
 /* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"), the
  * node at world point x: v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then
  * ln R and b/R. */
-static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, int closure, vec3 x, int node, NV_GLOBAL float* v,
-                                        uint first, uint count) {
+static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, int closure, int direct, vec3 x, int node,
+                                        NV_GLOBAL float* v, uint first, uint count) {
   for (uint k = first; k < first + count; ++k) {
     vec3 omega;
-    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, closure, x, node, k, &omega);
+    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, closure, direct, x, node, k, &omega);
     const float n = (float)(k + 1u);
     const float Lc[3] = {L.x, L.y, L.z};
     const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */
@@ -110,7 +111,7 @@ static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const r
   switch (rp->ms_cache_layout) {
     case MS_CACHE_LAYOUT_GRID:
       if (ms_cache_node_is_read(KERNEL_CONTEXT_ARG, c, node))
-        ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp->ms_cache_closure,
+        ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp->ms_cache_closure, rp->ms_cache_direct,
                              affine_point(c->index_to_world, node_grid_point(c, vec3_from4(ctx->medium->dims), node)),
                              node, v, first, count);
       return;
@@ -118,7 +119,8 @@ static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const r
       float tau;
       const vec3 x = ms_view_node_point(KERNEL_CONTEXT_ARG, rp, node, &tau);
       v[MS_VIEW_TAU] = tau;
-      if (tau >= 0.0f) ms_cache_refine_node(KERNEL_CONTEXT_ARG, MS_CACHE_CLOSURE_CAMERA, x, node, v, first, count);
+      if (tau >= 0.0f)
+        ms_cache_refine_node(KERNEL_CONTEXT_ARG, MS_CACHE_CLOSURE_CAMERA, rp->ms_cache_direct, x, node, v, first, count);
       return;
     }
     default: return; /* unknown: reported at the kernel's entry */

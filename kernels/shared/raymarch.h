@@ -178,7 +178,10 @@ static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const real
     const float dtau = sigma_grey * rho * dt;
     vec3 S = vec3_splat(0.0f);
     if (!vec3_is_zero(sigma_s)) {
-      vec3 Li = raymarch_light_sum(KERNEL_CONTEXT_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir);
+      /* The lights' unscattered light, unless the cache holds it too (ms_cache.h, "Direct"). */
+      vec3 Li = rp->ms_cache.nx > 0 && rp->ms_cache_direct
+                    ? vec3_splat(0.0f)
+                    : raymarch_light_sum(KERNEL_CONTEXT_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir);
       if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h), at the step's middle */
         Li = vec3_add(Li, raymarch_ms_cache(rp, m, ms_cache, cols, vec3_madd(seg->o, seg->d, t), tau + 0.5f * dtau, dir));
       S = vec3_mul(sigma_s, Li);

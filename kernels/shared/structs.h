@@ -171,6 +171,10 @@ typedef struct realtime_params {
   int ms_cache_layout;      /* raymarch: MS_CACHE_LAYOUT_GRID or _VIEW (ms_cache_view.h) */
   int ms_cache_tile;        /* MS_CACHE_LAYOUT_VIEW: pixels per column side (ms_cache.nx, ny columns) */
   int shadow_weighting;     /* raymarch: SHADOW_WEIGHTING_AREA or _PHASE (march_light_column) */
+  int ms_cache_direct;      /* raymarch: 1: the cache holds the lights' unscattered light too (ms_cache.h, "Direct") */
+  int pad0;
+  int pad1;
+  int pad2;
 } realtime_params;
 
 typedef struct scene_params {

@@ -57,7 +57,7 @@ TEST(StructLayoutHost, SizesAreMultiplesOf16) {
   EXPECT_EQ(sizeof(camera_params), 96u);
   EXPECT_EQ(sizeof(light_params), 96u);
   EXPECT_EQ(sizeof(node_grid_params), 64u);
-  EXPECT_EQ(sizeof(realtime_params), 208u);
+  EXPECT_EQ(sizeof(realtime_params), 224u);
   EXPECT_EQ(sizeof(majorant_grid_params), 32u);
   EXPECT_EQ(sizeof(emission_params), 112u);
   EXPECT_EQ(sizeof(medium_params), 256u);

@@ -45,17 +45,20 @@ inline RenderResult renderAlgorithm(const Scene& scene, SceneGrids grid = {}) {
 // code path of the cache's build and lookup runs; with the phase integrated exactly over rectangle
 // lights and the HG closure; "raymarch+ms-cache-camera" the same cache with its paths aimed at the
 // camera; "raymarch+ms-cache-view" the view layout, columns of 2x2 pixels, 4 slices, with the
-// rectangles' shadows weighted by the phase) and the corrected Lobe Estimator (its phase exact as
-// well).
+// rectangles' shadows weighted by the phase; "raymarch+ms-cache-direct" the same holding the
+// lights' unscattered light too, no light loop) and the corrected Lobe Estimator (its phase exact
+// as well).
 inline const char* const kHardCaseRenderers[] = {"pathtrace",         "raymarch",
                                                  "raymarch+octaves",  "raymarch+ms-cache",
                                                  "raymarch+ms-cache-camera", "raymarch+ms-cache-view",
-                                                 "lobe",              "lobe+corrected"};
+                                                 "raymarch+ms-cache-direct", "lobe",
+                                                 "lobe+corrected"};
 
 // `scene` rendered by one of kHardCaseRenderers (or any algorithm name), one frame for the
 // real-time ones.
 inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGrids grid = {}) {
-  if (renderer == "raymarch+ms-cache" || renderer == "raymarch+ms-cache-camera" || renderer == "raymarch+ms-cache-view") {
+  if (renderer == "raymarch+ms-cache" || renderer == "raymarch+ms-cache-camera" || renderer == "raymarch+ms-cache-view" ||
+      renderer == "raymarch+ms-cache-direct") {
     scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
     scene.renderer.raymarch.msCache.resolution = 4;
@@ -64,11 +67,12 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGr
     scene.renderer.raymarch.msCache.closure = renderer == "raymarch+ms-cache"
                                                   ? MsCacheClosure::Hg       // the HG closure of the moments
                                                   : MsCacheClosure::Camera;  // the paths aimed at the camera
-    if (renderer == "raymarch+ms-cache-view") {
+    if (renderer == "raymarch+ms-cache-view" || renderer == "raymarch+ms-cache-direct") {
       scene.renderer.raymarch.msCache.layout = MsCacheLayout::View;
       scene.renderer.raymarch.msCache.tile = 2;
       scene.renderer.raymarch.msCache.slices = 4;
       scene.renderer.raymarch.shadowWeighting = ShadowWeighting::Phase;
+      scene.renderer.raymarch.msCache.direct = renderer == "raymarch+ms-cache-direct";
     }
   } else if (renderer == "raymarch+octaves") {
     scene.renderer.algorithm = Algorithm::Raymarch;

@@ -171,14 +171,13 @@ TEST(AreaLight, PointLightIgnoresK) {
   EXPECT_EQ(status, 0u);
 }
 
-// The shadow weighted by the phase (SHADOW_WEIGHTING_PHASE): each of the K×K points counts by its
-// share of the light scattered along the view direction, p(g, view·dir)·cos θ_l/d², so the column
-// converges to −ln(∫ p w e^{−σℓ} / ∫ p w)/σ, the transmittance the single scattering towards the
-// camera sees (∫ p T dω = T̄·∫ p dω exactly). The same second-order midpoint rule: K = 16 within 1%
-// of the reference, K = 4 within 10% (HG 0.8 varies faster over the light than cos/d², so the
-// tolerances are twice the area weighting's). It differs from the area-weighted column by more
-// than 10% at some point here (the phase favours the part of the light ahead of the view
-// direction), and with an isotropic phase function the two weightings give the same column.
+// The shadow weighted by the phase (SHADOW_WEIGHTING_PHASE, march_light_column_phase): the column
+// converges to −ln(∫ p w e^{−σℓ} / ∫ p w)/σ over the light's area (w = cos θ_l/d², the solid angle
+// per area), the transmittance the single scattering towards the camera sees (∫ p T dω = T̄·∫ p dω
+// exactly): K = 16 within 1% of the reference, K = 4 within 10%. It differs from the area-weighted
+// column by more than 10% at some point here (the phase favours the part of the light ahead of the
+// view direction). For an isotropic phase function the two weightings estimate the same integral
+// (within 1% at K = 8: two deterministic patterns, not the same arithmetic).
 TEST(AreaLight, PhaseWeightedColumnConvergesToThePhaseWeightedTransmittance) {
   Fixture f;
   const light_params& l = f.ds.lights[0];
@@ -202,9 +201,10 @@ TEST(AreaLight, PhaseWeightedColumnConvergesToThePhaseWeightedTransmittance) {
   EXPECT_GT(widest, 0.1);
   m.phase = PHASE_ISOTROPIC;
   const vec3 x = vec3_make(0.1f, -0.2f, 0.3f);
+  const float area = march_light_column(narval::test::hostContext(&m, &f.grid, &status), &l, x, 8, 8,
+                                        SHADOW_WEIGHTING_AREA, vf);
   EXPECT_NEAR(march_light_column(narval::test::hostContext(&m, &f.grid, &status), &l, x, 8, 8, SHADOW_WEIGHTING_PHASE, vf),
-              march_light_column(narval::test::hostContext(&m, &f.grid, &status), &l, x, 8, 8, SHADOW_WEIGHTING_AREA, vf),
-              1e-6);
+              area, 0.01 * area);
   EXPECT_EQ(status, 0u);
 }
 
