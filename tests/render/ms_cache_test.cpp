@@ -336,6 +336,17 @@ LitBoxCheck checkLitBox(const std::string& phase, const std::string& coarseCache
   return out;
 }
 
+// Prints what checkLitBox measured (`what`: the test's case; `other`: what the other renderer is)
+// and asserts the bound's widest share of the value and the share of tile channels the other
+// renderer leaves outside it.
+void expectLitBox(const LitBoxCheck& c, const char* what, const char* other, double widestBound, double otherShare) {
+  std::printf("[ ms cache ] lit box, %s: worst |error|/bound %.2f, widest bound %.2f%% of the value, %s outside the "
+              "bound on %.0f of %zu tile channels\n",
+              what, c.worstRatio, 100 * c.worstBound, other, c.otherOutside, c.tiles);
+  EXPECT_LE(c.worstBound, widestBound);
+  EXPECT_GE(c.otherOutside, otherShare * double(c.tiles));
+}
+
 // With an isotropic phase function the in-scattered radiance at a point is the directional average
 // of the radiance arriving there, and that is what the cache stores for all light but the light's
 // unscattered part, which the march adds exactly (a point light, exact shadow marches: the light
@@ -356,11 +367,7 @@ LitBoxCheck checkLitBox(const std::string& phase, const std::string& coarseCache
 TEST(MsCache, IsotropicLitBoxMatchesThePathTracer) {
   const LitBoxCheck c = checkLitBox(R"("phaseFunction": "isotropic")", R"("resolution": 8)", R"("resolution": 16)",
                                     "none", R"("resolution": 8)");
-  std::printf("[ ms cache ] lit isotropic box: worst |error|/bound %.2f, widest bound %.2f%% of the value, "
-              "single scattering alone outside the bound on %.0f of %zu tile channels\n",
-              c.worstRatio, 100 * c.worstBound, c.otherOutside, c.tiles);
-  EXPECT_LE(c.worstBound, 0.06);
-  EXPECT_GE(c.otherOutside, 0.9 * double(c.tiles));
+  expectLitBox(c, "isotropic", "single scattering alone", 0.06, 0.9);
 }
 
 // The closure "camera" draws each node's path directions from the phase function about the
@@ -377,11 +384,7 @@ TEST(MsCache, IsotropicLitBoxMatchesThePathTracer) {
 TEST(MsCache, CameraClosureMatchesThePathTracerForAForwardPhaseFunction) {
   const LitBoxCheck c = checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("resolution": 8, "closure": "camera")",
                                     R"("resolution": 16, "closure": "camera")", "cache", R"("resolution": 8)");
-  std::printf("[ ms cache ] lit HG 0.8 box, closure camera: worst |error|/bound %.2f, widest bound %.2f%% of the "
-              "value, the linear closure outside the bound on %.0f of %zu tile channels\n",
-              c.worstRatio, 100 * c.worstBound, c.otherOutside, c.tiles);
-  EXPECT_LE(c.worstBound, 0.2);
-  EXPECT_GE(c.otherOutside, 0.5 * double(c.tiles));
+  expectLitBox(c, "HG 0.8, closure camera", "the linear closure", 0.2, 0.5);
 }
 
 // The view layout (ms_cache_view.h) holds the same in-scattering towards the camera as the closure
@@ -397,11 +400,7 @@ TEST(MsCache, CameraClosureMatchesThePathTracerForAForwardPhaseFunction) {
 TEST(MsCache, ViewLayoutMatchesThePathTracerForAForwardPhaseFunction) {
   const LitBoxCheck c = checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8)",
                                     R"("layout": "view", "tile": 1, "slices": 15)", "cache", R"("resolution": 8)");
-  std::printf("[ ms cache ] lit HG 0.8 box, layout view: worst |error|/bound %.2f, widest bound %.2f%% of the "
-              "value, the linear closure outside the bound on %.0f of %zu tile channels\n",
-              c.worstRatio, 100 * c.worstBound, c.otherOutside, c.tiles);
-  EXPECT_LE(c.worstBound, 0.25);
-  EXPECT_GE(c.otherOutside, 0.5 * double(c.tiles));
+  expectLitBox(c, "HG 0.8, layout view", "the linear closure", 0.25, 0.5);
 }
 
 // With msCache.direct the view layout's nodes hold the lights' unscattered light as well, from the
@@ -417,12 +416,7 @@ TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracer) {
       checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
                   R"("layout": "view", "tile": 1, "slices": 15, "direct": true)", "cache", R"("resolution": 8)",
                   kLitBoxPanel);
-  std::printf("[ ms cache ] lit HG 0.8 box, rectangle light, layout view with the direct light: worst |error|/bound "
-              "%.2f, widest bound %.2f%% of the value, the linear closure outside the bound on %.0f of %zu tile "
-              "channels\n",
-              c.worstRatio, 100 * c.worstBound, c.otherOutside, c.tiles);
-  EXPECT_LE(c.worstBound, 0.3);
-  EXPECT_GE(c.otherOutside, 0.5 * double(c.tiles));
+  expectLitBox(c, "HG 0.8, rectangle light, layout view with the direct light", "the linear closure", 0.3, 0.5);
 }
 
 }  // namespace
