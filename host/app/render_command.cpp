@@ -285,7 +285,8 @@ int runRender(const RenderArgs& a) {
               << s.lightCacheMs << " ms (not in the frame times)\n";
   if (s.msCacheBuilds > 0)
     report << "multiple-scattering cache: " << s.msCacheCells[0] << "x" << s.msCacheCells[1] << "x"
-              << s.msCacheCells[2] << (s.msCacheView ? " columns x rows x slices, " : " cells, ") << s.msCachePaths << " paths per node in " << s.msCacheMs
+              << s.msCacheCells[2] << (s.msCacheView ? " columns x rows x slices, " : " cells, ") << s.msCachePaths
+              << " paths per node in " << s.msCacheMs
               << " ms (not in the frame times)\n";
   report << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
             << s.algorithm << ", ";

@@ -329,6 +329,17 @@ static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, 
   }
 }
 
+/* The effective column of weighted shadow rays, −ln(Σ w e^{−σ̄C}/Σ w)/σ̄, from Σ w, Σ w·(e^{−σ̄C} − 1)
+ * and Σ w·C: through expm1 and log1p, so a thin column keeps its digits. No extinction, or every ray
+ * fully shadowed: the weighted mean column (the limit σ̄ → 0, and as dark as the float allows
+ * otherwise). Nothing weighted (nothing of the light faces x, or x is the point light): 0. */
+static inline float march_mean_column(float w_sum, float loss_sum, float column_sum, float sigma) {
+  if (!(w_sum > 0.0f)) return 0.0f;
+  const float mean_loss = loss_sum / w_sum;
+  if (!(sigma > 0.0f) || !(mean_loss > -1.0f)) return column_sum / w_sum;
+  return -nv_log1p(mean_loss) / sigma;
+}
+
 /* A rectangle's effective column weighted by the phase towards the camera (SHADOW_WEIGHTING_PHASE):
  * T̄ = ∫ p(view_dir·ω) T(ω) dω / ∫ p(view_dir·ω) dω over the light's solid angle, so that
  * Le·T̄·∫ p dω (march_light_phase) is the single scattering ∫ Le p T dω whenever the phase and the
@@ -378,10 +389,7 @@ static inline float march_light_column_phase(KERNEL_CONTEXT_PARAM, NV_CONSTANT c
         loss_sum += w * nv_expm1(-sigma * column);
         column_sum += w * column;
       }
-  if (!(w_sum > 0.0f)) return 0.0f;
-  const float mean_loss = loss_sum / w_sum;
-  if (!(sigma > 0.0f) || !(mean_loss > -1.0f)) return column_sum / w_sum;
-  return -nv_log1p(mean_loss) / sigma;
+  return march_mean_column(w_sum, loss_sum, column_sum, sigma);
 }
 
 /* Column density from x to light l, ∫ρ ds over shadow_steps midpoint samples: to the light itself
@@ -434,13 +442,7 @@ static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const l
       loss_sum += w * nv_expm1(-sigma * column);
       column_sum += w * column;
     }
-  if (!(w_sum > 0.0f)) return 0.0f; /* nothing of the light faces x (or x is the point light) */
-  /* −ln(1 + mean loss)/σ̄ through expm1 and log1p: a thin column keeps its digits. No extinction, or
-   * every point fully shadowed: the weighted mean column (the limit σ̄ → 0, and as dark as the float
-   * allows otherwise). */
-  const float mean_loss = loss_sum / w_sum;
-  if (!(sigma > 0.0f) || !(mean_loss > -1.0f)) return column_sum / w_sum;
-  return -nv_log1p(mean_loss) / sigma;
+  return march_mean_column(w_sum, loss_sum, column_sum, sigma);
 }
 
 /* L_b for the real-time kernels: what the view ray would see with the medium removed, i.e. the
