@@ -15,7 +15,8 @@
  * image point ((cx + ½)·tile, (cy + ½)·tile), tile = realtime_params.ms_cache_tile pixels. Along it,
  * τ(t) is marched with MS_VIEW_PLACE_STEPS samples over its occupied majorant cells (march.h), in
  * the grey extinction σ̄t (the mean of the three channels, per unit density), to its total τ_end
- * (capped at τ_max = −ln MS_VIEW_T_MIN: past it the pixel sees under 1% of the medium). Node s sits
+ * (march_column_density; levels stop at τ_max = −ln MS_VIEW_T_MIN: past it the pixel sees under
+ * 1% of the medium). Node s sits
  * where the transmittance has fallen to
  *   T_s = 1 − (1 − T_end)·s/(nz − 1),   T_end = max(e^{−τ_end}, MS_VIEW_T_MIN),
  * equal shares of what the pixel sees: s = 0 at the medium's first sample, nz − 1 at its end (or at
@@ -66,19 +67,15 @@ static inline vec3 ms_view_node_point(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
   *tau = -1.0f;
   medium_segment seg;
   if (!s->has_medium || !march_view_segment(s, ctx->lights, r.origin, r.dir, &seg)) return r.origin;
-  const float sigma = ms_view_sigma_t(&s->medium), tau_max = -nv_log(MS_VIEW_T_MIN);
-  /* First march: τ_end. */
-  float total = 0.0f, t;
-  march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_PLACE_STEPS);
-  while (total < tau_max && march_next(&it, KERNEL_CONTEXT_ARG, &t))
-    total += sigma * nv_fmax(grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg.o, seg.d, t)), 0.0f) * it.delta;
-  ctx->status |= it.status;
+  const float sigma = ms_view_sigma_t(&s->medium);
+  /* First march: τ_end, the column over the same samples as the second (the segment [t0, t1] again). */
+  const float total = sigma * march_column_density(KERNEL_CONTEXT_ARG, r.origin, r.dir, seg.t1, MS_VIEW_PLACE_STEPS);
   if (!(total > 0.0f)) return r.origin;
   const float t_end = nv_fmax(nv_exp(-total), MS_VIEW_T_MIN);
   const float level = -nv_log(1.0f - (1.0f - t_end) * (float)slice / (float)(c->nz - 1));
   /* Second march: where τ(t), linear over each step, reaches the level. */
-  float acc = 0.0f, at = seg.t0;
-  it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_PLACE_STEPS);
+  float acc = 0.0f, at = seg.t0, t;
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_PLACE_STEPS);
   while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
     const float d = sigma * nv_fmax(grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg.o, seg.d, t)), 0.0f) * it.delta;
     if (!(d > 0.0f)) continue;
