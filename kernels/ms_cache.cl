@@ -1,6 +1,7 @@
 /* ms_cache.cl: adds `count` paths per node to the multiple-scattering cache (shared/ms_cache_build.h),
- * paths [first, first + count) of each node. One work-item per node (1D, padded to a multiple of
- * the local size). `scene` is the scene with one bounce fewer (ms_cache.h, "Bounces"). */
+ * paths [first, first + count) of each node, after the view layout's nodes were placed (once per
+ * cache). One work-item per node (1D, padded to a multiple of the local size). `scene` is the scene
+ * with one bounce fewer (ms_cache.h, "Bounces"). */
 #include "shared/scene_kinds.h"
 #include "shared/ms_cache_build.h"
 
@@ -13,5 +14,18 @@ __kernel void ms_cache_build(KERNEL_SCENE_ARGS,
   KERNEL_CONTEXT_BEGIN(ctx);
   ctx.status = scene_kinds_status(scene, lights) | realtime_kinds_status(params); /* STATUS_UNKNOWN_KIND */
   ms_cache_build_node(KERNEL_ENTRY_ARG(ctx), params, node, cache + (size_t)node * MS_CACHE_STRIDE, first, count);
+  if (ctx.status) atomic_or(status_word, ctx.status);
+}
+
+/* The view layout's placement (ms_cache_view.h, ms_view_place_column): one work-item per column,
+ * run once when the cache starts over, before ms_cache_build. */
+__kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, __constant realtime_params* params, __global float* cache,
+                                  __global uint* status_word) {
+  const int column = get_global_id(0);
+  __constant node_grid_params* c = &params->ms_cache;
+  if (column >= c->nx * c->ny) return;
+  KERNEL_CONTEXT_BEGIN(ctx);
+  ctx.status = scene_kinds_status(scene, lights) | realtime_kinds_status(params); /* STATUS_UNKNOWN_KIND */
+  ms_view_place_column(KERNEL_ENTRY_ARG(ctx), params, column, cache + (size_t)column * MS_CACHE_STRIDE);
   if (ctx.status) atomic_or(status_word, ctx.status);
 }

@@ -28,6 +28,7 @@ const std::map<std::string, std::vector<std::string>>& lists() {
       {"lobe", sceneArgsAnd({"params", "lobe_directions", "light_cache", "ms_cache", "out", "status_word"})},
       {"light_cache_build", sceneArgsAnd({"params", "light", "cache", "status_word"})},
       {"ms_cache_build", sceneArgsAnd({"params", "first", "count", "cache", "status_word"})},
+      {"ms_cache_place_view", sceneArgsAnd({"params", "cache", "status_word"})},
   };
   return all;
 }

@@ -41,6 +41,17 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
     paths_ = 0;
     ++rebuilds_;
     key_ = key;
+    paramBuf_ = constantBuffer(rt, params);
+    if (view) {  // the nodes' places along their columns, once (ms_cache_view.h, "Layout")
+      NamedKernel place(program_, "ms_cache_place_view");
+      dev.bind(place);
+      place.set("scene", sceneBuf_);
+      place.set("params", paramBuf_);
+      place.set("cache", buffer_);
+      place.set("status_word", statusBuf_);
+      buildMs_ += launchOverNodes(rt, place.get(), size_t(c.nx) * size_t(c.ny), "the multiple-scattering cache",
+                                  deviceSceneBytes(dev.scene) + bytes_);
+    }
   }
   if (paths_ >= targetPaths) return;
   paramBuf_ = constantBuffer(rt, params);

@@ -104,7 +104,7 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, int closure, int d
 
 /* One launch's work for node `node` (ms_cache.cl): paths [first, first + count) at the node's point,
  * for the cache's layout. A grid node no lookup reads is left at 0 (ms_cache_node_is_read); a view
- * node stores its optical depth, and no paths when its column holds no medium (ms_cache_view.h). */
+ * node sits where ms_view_place_column put it, and takes no paths when its column holds no medium. */
 static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
                                        NV_GLOBAL float* v, uint first, uint count) {
   NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
@@ -115,14 +115,11 @@ static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const r
                              affine_point(c->index_to_world, node_grid_point(c, vec3_from4(ctx->medium->dims), node)),
                              node, v, first, count);
       return;
-    case MS_CACHE_LAYOUT_VIEW: {
-      float tau;
-      const vec3 x = ms_view_node_point(KERNEL_CONTEXT_ARG, rp, node, &tau);
-      v[MS_VIEW_TAU] = tau;
-      if (tau >= 0.0f)
-        ms_cache_refine_node(KERNEL_CONTEXT_ARG, MS_CACHE_CLOSURE_CAMERA, rp->ms_cache_direct, x, node, v, first, count);
+    case MS_CACHE_LAYOUT_VIEW: /* placed once per cache by ms_cache_place_view */
+      if (v[MS_VIEW_TAU] >= 0.0f)
+        ms_cache_refine_node(KERNEL_CONTEXT_ARG, MS_CACHE_CLOSURE_CAMERA, rp->ms_cache_direct,
+                             ms_view_node_point(ctx->scene, rp, node, v), node, v, first, count);
       return;
-    }
     default: return; /* unknown: reported at the kernel's entry */
   }
 }

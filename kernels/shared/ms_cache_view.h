@@ -12,7 +12,8 @@
  *
  * Layout (node_grid_params ms_cache: nx·ny columns, nz = slices per column; node (cx, cy, s) at index
  * cx + nx·(cy + ny·s), MS_CACHE_STRIDE floats each): column (cx, cy) is the camera ray through the
- * image point ((cx + ½)·tile, (cy + ½)·tile), tile = realtime_params.ms_cache_tile pixels. Along it,
+ * image point ((cx + ½)·tile, (cy + ½)·tile), tile = realtime_params.ms_cache_tile pixels. Along it
+ * (once per cache, before any paths: ms_view_place_column),
  * τ(t) is marched with MS_VIEW_PLACE_STEPS samples over its occupied majorant cells (march.h), in
  * the grey extinction σ̄t (the mean of the three channels, per unit density), to its total τ_end
  * (march_column_density; levels stop at τ_max = −ln MS_VIEW_T_MIN: past it the pixel sees under
@@ -42,6 +43,7 @@
 #include "shared/ms_cache.h"
 
 #define MS_VIEW_TAU 29 /* node's grey optical depth from the camera; −1: its column holds no medium */
+#define MS_VIEW_T 30   /* node's distance from the camera along its column's ray */
 #define MS_VIEW_T_MIN 0.01f
 #define MS_VIEW_PLACE_STEPS 256
 
@@ -56,38 +58,60 @@ static inline float ms_view_sigma_t(NV_CONSTANT const medium_params* m) {
   return (st.x + st.y + st.z) / 3.0f;
 }
 
-/* Node `node`'s world point; *tau its optical depth, −1 when its column holds no medium (the point
- * is then meaningless). Marches the column twice: for τ_end, then to the node's level ("Layout"). */
-static inline vec3 ms_view_node_point(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
-                                      NV_PRIVATE float* tau) {
+/* Places column `column`'s nodes ("Layout"), once per cache (ms_cache_place_view, before any
+ * paths): marches the column for τ_end, then once more to every node's level, and writes each
+ * node's τ (−1 when the column holds no medium) and its distance along the column's ray, which the
+ * build then reads (ms_view_node_point) instead of marching again at every launch. `cache` points
+ * at the column's first node (slice 0); slice s is nx·ny nodes further. */
+static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int column,
+                                        NV_GLOBAL float* cache) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
-  const int cx = node % c->nx, cy = (node / c->nx) % c->ny, slice = node / (c->nx * c->ny);
-  const ray3 r = ms_view_column_ray(&s->camera, rp->ms_cache_tile, cx, cy);
-  *tau = -1.0f;
+  const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
+  const ray3 r = ms_view_column_ray(&s->camera, rp->ms_cache_tile, column % c->nx, column / c->nx);
+  for (int slice = 0; slice < c->nz; ++slice) {
+    cache[(size_t)slice * slice_stride + MS_VIEW_TAU] = -1.0f;
+    cache[(size_t)slice * slice_stride + MS_VIEW_T] = 0.0f;
+  }
   medium_segment seg;
-  if (!s->has_medium || !march_view_segment(s, ctx->lights, r.origin, r.dir, &seg)) return r.origin;
+  if (!s->has_medium || !march_view_segment(s, ctx->lights, r.origin, r.dir, &seg)) return;
   const float sigma = ms_view_sigma_t(&s->medium);
   /* First march: τ_end, the column over the same samples as the second (the segment [t0, t1] again). */
   const float total = sigma * march_column_density(KERNEL_CONTEXT_ARG, r.origin, r.dir, seg.t1, MS_VIEW_PLACE_STEPS);
-  if (!(total > 0.0f)) return r.origin;
+  if (!(total > 0.0f)) return;
   const float t_end = nv_fmax(nv_exp(-total), MS_VIEW_T_MIN);
-  const float level = -nv_log(1.0f - (1.0f - t_end) * (float)slice / (float)(c->nz - 1));
-  /* Second march: where τ(t), linear over each step, reaches the level. */
-  float acc = 0.0f, at = seg.t0, t;
+  /* Second march: where τ(t), linear over each step, reaches each level in turn; levels it does not
+   * reach (rounding, or past τ_max) lie at the end of the last step with medium. */
+  int slice = 0;
+  float acc = 0.0f, end = seg.t0, t;
   march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_PLACE_STEPS);
-  while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
+  while (slice < c->nz && march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
     const float d = sigma * nv_fmax(grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg.o, seg.d, t)), 0.0f) * it.delta;
     if (!(d > 0.0f)) continue;
-    at = t + 0.5f * it.delta; /* the end of the last step with medium: where the deepest level lies */
-    if (acc + d >= level) {
-      at = t - 0.5f * it.delta + it.delta * nv_fmin(1.0f, nv_fmax(0.0f, (level - acc) / d));
-      break;
+    end = t + 0.5f * it.delta;
+    for (; slice < c->nz; ++slice) {
+      const float level = -nv_log(1.0f - (1.0f - t_end) * (float)slice / (float)(c->nz - 1));
+      if (acc + d < level) break;
+      NV_GLOBAL float* v = cache + (size_t)slice * slice_stride;
+      v[MS_VIEW_TAU] = level;
+      v[MS_VIEW_T] = t - 0.5f * it.delta + it.delta * nv_fmin(1.0f, nv_fmax(0.0f, (level - acc) / d));
     }
     acc += d;
   }
-  *tau = level;
-  return vec3_madd(r.origin, r.dir, at);
+  for (; slice < c->nz; ++slice) {
+    NV_GLOBAL float* v = cache + (size_t)slice * slice_stride;
+    v[MS_VIEW_TAU] = -nv_log(1.0f - (1.0f - t_end) * (float)slice / (float)(c->nz - 1));
+    v[MS_VIEW_T] = end;
+  }
+}
+
+/* Node `node`'s world point, placed by ms_view_place_column; its τ is v[MS_VIEW_TAU] (−1: its
+ * column holds no medium, and the point is meaningless). */
+static inline vec3 ms_view_node_point(NV_CONSTANT const scene_params* s, NV_CONSTANT const realtime_params* rp,
+                                      int node, NV_GLOBAL const float* v) {
+  NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
+  const ray3 r = ms_view_column_ray(&s->camera, rp->ms_cache_tile, node % c->nx, (node / c->nx) % c->ny);
+  return vec3_madd(r.origin, r.dir, v[MS_VIEW_T]);
 }
 
 /* A pixel's four columns and their bilinear weights (0 for a column past the image's last). */

@@ -16,7 +16,7 @@ namespace {
 
 std::vector<std::string> deviceArgumentNames(ClRuntime& rt, const std::string& kernel, const std::string& options) {
   const cl::Program program = buildProgram(rt, kernel == "light_cache_build" ? "light_cache.cl"
-                                               : kernel == "ms_cache_build"  ? "ms_cache.cl"
+                                               : kernel.rfind("ms_cache_", 0) == 0 ? "ms_cache.cl"
                                                                              : kernel + ".cl",
                                            options + " -cl-kernel-arg-info");
   const cl::Kernel k(program, kernel.c_str());
@@ -33,7 +33,8 @@ std::vector<std::string> deviceArgumentNames(ClRuntime& rt, const std::string& k
 TEST(KernelArgs, EveryListIsItsKernelsSignatureInEveryVariant) {
   ClRuntime rt("");
   const std::vector<std::string> kernels = kernelsWithArgumentNames();
-  ASSERT_EQ(kernels, (std::vector<std::string>{"light_cache_build", "lobe", "ms_cache_build", "pathtrace", "raymarch"}));
+  ASSERT_EQ(kernels, (std::vector<std::string>{"light_cache_build", "lobe", "ms_cache_build", "ms_cache_place_view", "pathtrace",
+                                                "raymarch"}));
   for (const std::string& kernel : kernels) {
     std::vector<std::string> listed = kernelArgumentNames(kernel);
     // Bricks take the buffer's signature (grid.h): the three kinds of grid argument are these.

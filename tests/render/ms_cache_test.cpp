@@ -13,6 +13,7 @@
 #include "render/node_grid.h"
 #include "render/realtime_renderer.h"
 #include "shared/ms_cache.h"
+#include "shared/ms_cache_view.h"
 #include "render_fixture.h"
 #include "test_support.h"
 #include "volume/grid.h"
@@ -121,12 +122,25 @@ std::vector<float> cacheAfter(const Scene& scene, int paths, int perLaunch) {
 }
 
 // Path k of node n draws from its own stream and the running mean adds paths in index order, so
-// the cache after K paths does not depend on how the launches split them: bit for bit.
+// the cache after K paths does not depend on how the launches split them: bit for bit. The view
+// layout's nodes are placed once, before the first launch (ms_cache_place_view): the same there,
+// and every node of a column that meets the box holds its K paths.
 TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
-  const Scene scene = litBox();
+  Scene scene = litBox();
   const std::vector<float> one = cacheAfter(scene, 48, 48), many = cacheAfter(scene, 48, 5);
   EXPECT_EQ(one, many);
   for (size_t i = 3; i < one.size(); i += MS_CACHE_STRIDE) ASSERT_EQ(one[i], 48.0f);  // the count
+  scene.renderer.raymarch.msCache.layout = MsCacheLayout::View;
+  scene.renderer.raymarch.msCache.tile = 2;
+  const std::vector<float> viewOne = cacheAfter(scene, 48, 48), viewMany = cacheAfter(scene, 48, 5);
+  EXPECT_EQ(viewOne, viewMany);
+  int placed = 0;
+  for (size_t i = 0; i < viewOne.size(); i += MS_CACHE_STRIDE) {
+    if (viewOne[i + MS_VIEW_TAU] < 0.0f) continue;
+    ++placed;
+    ASSERT_EQ(viewOne[i + 3], 48.0f);
+  }
+  EXPECT_GT(placed, 0);
 }
 
 // refine() to `paths` paths per node for `scene` seen from another camera position, (1, 1, −4).

@@ -1,10 +1,15 @@
 // The view-space layout of the multiple-scattering cache (kernels/shared/ms_cache_view.h): how a
-// pixel finds its columns and how a column is read along the optical depth.
+// pixel finds its columns, how a column is read along the optical depth, and where its nodes are placed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
+#include "render/scene_upload.h"
+#include "scene/scene.h"
 #include "shared/ms_cache_view.h"
+#include "unit/host_context.h"
 
 namespace narval::test {
 namespace {
@@ -93,6 +98,62 @@ TEST(MsCacheView, ColumnsWithoutMediumDropOut) {
   EXPECT_FLOAT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &cols, 0.5f).x, 7.0f);
   for (int s = 0; s < 2; ++s) cache[size_t(1 + 2 * s) * MS_CACHE_STRIDE + MS_VIEW_TAU] = -1.0f;
   EXPECT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &cols, 0.5f).x, 0.0f);
+}
+
+// Placement in a homogeneous cube [−½, ½]³ of σt = 6 (grey), seen from (0, 0, −4) at 30°: along a
+// column's ray τ(t) = 6·(t − t0) exactly (the march's linear τ within a step is then exact), so
+// node s sits at t_s = t0 + level_s/6, level_s = −ln(1 − (1 − T_end)·s/(nz − 1)) with T_end =
+// max(e^{−τ_end}, 0.01) ("Layout"); τ_end = 6·(t1 − t0) ≈ 6 passes τ_max = ln 100 = 4.61, so the
+// last node lies at τ_max, inside the cube. In the 8x8 image at tile 2 the inner four columns'
+// rays (pixel centres 3 and 5: 0.25 of the half-width, 0.23 world units off the axis at the front
+// face) cross the cube front to back; the outer twelve (0.75: 0.70 off it) miss it and hold τ = −1.
+// Tolerance 1e-4 world units: 256 float steps of τ.
+TEST(MsCacheView, NodesSitAtEqualStepsOfTheCamerasTransmittance) {
+  const Scene scene = parseScene(R"({
+    "materials": [{"name": "m", "type": "volume", "scattering": [5, 5, 5], "absorption": [1, 1, 1]}],
+    "primitives": [{"name": "v", "type": "volume", "transform": {"scale": [1, 1, 1]}, "materialName": "m"}],
+    "camera": {"position": [0, 0, -4], "lookAt": [0, 0, 0], "vfov": 30},
+    "renderer": {"resolution": [8, 8]}
+  })", "cube.json");
+  const DeviceScene ds = buildDeviceScene(scene, nullptr);
+  const float global = 1.0f;  // the homogeneous medium's one majorant cell
+  const grid_view homogeneous{nullptr, 1, 1, 1, &global};
+  const realtime_params rp = viewParams(4, 4, 5, 2);
+  std::vector<float> cache(size_t(4 * 4 * 5) * MS_CACHE_STRIDE, 0.0f);
+  for (int column = 0; column < 16; ++column)
+    ms_view_place_column(narval::test::sceneContext(&ds.params, ds.lights.data(), &homogeneous), &rp, column,
+                         cache.data() + size_t(column) * MS_CACHE_STRIDE);
+  int crossing = 0;
+  for (int column = 0; column < 16; ++column) {
+    const int cx = column % 4, cy = column / 4;
+    const ray3 r = ms_view_column_ray(&ds.params.camera, 2, cx, cy);
+    // The ray against the cube's slabs.
+    double t0 = 0, t1 = 1e30;
+    const double o[3] = {r.origin.x, r.origin.y, r.origin.z}, d[3] = {r.dir.x, r.dir.y, r.dir.z};
+    for (int a = 0; a < 3; ++a) {
+      const double ta = (-0.5 - o[a]) / d[a], tb = (0.5 - o[a]) / d[a];
+      t0 = std::max(t0, std::min(ta, tb));
+      t1 = std::min(t1, std::max(ta, tb));
+    }
+    const bool inner = (cx == 1 || cx == 2) && (cy == 1 || cy == 2);
+    ASSERT_EQ(t0 < t1, inner) << "column " << column;
+    crossing += inner;
+    const double tEnd = std::max(std::exp(-6.0 * (t1 - t0)), 0.01);
+    for (int s = 0; s < 5; ++s) {
+      const float* v = cache.data() + size_t(column + 16 * s) * MS_CACHE_STRIDE;
+      if (!inner) {
+        EXPECT_EQ(v[MS_VIEW_TAU], -1.0f) << "column " << column << " slice " << s;
+        continue;
+      }
+      const double level = -std::log(1.0 - (1.0 - tEnd) * s / 4.0);
+      EXPECT_NEAR(v[MS_VIEW_TAU], level, 1e-5) << "column " << column << " slice " << s;
+      EXPECT_NEAR(v[MS_VIEW_T], t0 + level / 6.0, 1e-4) << "column " << column << " slice " << s;
+      const vec3 x = ms_view_node_point(&ds.params, &rp, column + 16 * s, v);
+      EXPECT_NEAR(x.z, r.origin.z + r.dir.z * (t0 + level / 6.0), 1e-4) << "column " << column << " slice " << s;
+    }
+    if (inner) EXPECT_LT(t0 + std::log(100.0) / 6.0, t1);  // the deepest node is capped at τ_max, inside
+  }
+  EXPECT_EQ(crossing, 4);
 }
 
 }  // namespace
