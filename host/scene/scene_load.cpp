@@ -627,13 +627,6 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
   bool emits = false;
   for (const Material& m : scene.materials) emits = emits || m.emission.kind != EmissionKind::None;
   scene.renderer = readRenderer(ctx, root.require("renderer"), "renderer", emits);
-  // A cache holding the lights' unscattered light gets it from paths that meet the light: a point
-  // light is never met (kernels/shared/ms_cache.h, "Direct").
-  if (scene.renderer.raymarch.msCache.direct)
-    for (const Primitive& p : scene.primitives)
-      if (p.type == PrimitiveType::Point)
-        ctx.fail("renderer.raymarch.msCache.direct", "needs rectangle lights: point light \"" + p.name +
-                                                         "\" is never met by the cache's paths");
   scene.background = root.getVec3("background", scene.background);
   checkNonNegative(ctx, "background", scene.background);
   root.reportUnknown();

@@ -65,14 +65,17 @@
  * linear one, 32 cells, against an 8192-spp reference); the back-lit Disney cloud paints blocks with
  * the linear one (13.7% → 17.3%).
  *
- * Direct (realtime_params.ms_cache_direct; closure camera or the view layout only): the paths keep
- * the emitter their first segment meets (pathtrace_radiance's unscattered_emitters), so a node
- * holds the whole in-scattering towards the camera, the lights' unscattered light included, and
- * the march makes no light loop (no shadow rays, no light cache): a frame is the view march and
- * one lookup per sample. The first segment is drawn from the phase function, so this is the phase
- * sampling of the direct light: good for a large light in the phase's peak (a cloud lit from
- * behind, where the shadow must follow the peak: march.h, march_light_column_phase), noisy for a
- * small one, and blind to a point light, which the loader refuses with it.
+ * Direct (realtime_params.ms_cache_direct; closure camera or the view layout only): a node holds
+ * the whole in-scattering towards the camera, the lights' unscattered light included, and the march
+ * makes no light loop (no shadow rays, no light cache): a frame is the view march and one lookup per
+ * sample. Each path treats its start as a scattering event of a camera path arriving along −w_c:
+ * the path tracer's next-event estimate there (pathtrace_direct: shadow rays by ratio tracking,
+ * point lights included), and the emitter its first segment meets weighted against it by MIS
+ * (pathtrace_radiance's first_phase_pdf), as at any event of a path-traced pixel. So the shadow
+ * follows the phase's peak wherever it points (a cloud lit from behind: march.h,
+ * march_light_column_phase) at the cost of the path tracer's variance. Measured on the back-lit
+ * Disney cloud (view, tile 2, 512 paths): two cache seeds differ by JND 7.3% with the phase
+ * sampling alone, 6.1% with the next-event estimate, for 35% more build time.
  *
  * Storage: MS_CACHE_STRIDE floats per node: the running means of the paths so far, R (rgb) then
  * their count, then b for red, green and blue (xyz each, then an unused float); then what the

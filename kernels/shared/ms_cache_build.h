@@ -12,36 +12,49 @@
  * share the numbers of pixel n's camera samples. */
 #define MS_CACHE_SEED_OFFSET 0x6d73u
 
+/* The direction from x to the camera, w_c; a node at the camera's very position takes −forward. */
+static inline vec3 ms_cache_to_camera(NV_CONSTANT const scene_params* s, vec3 x) {
+  const vec3 to_camera = vec3_sub(vec3_from4(s->camera.position), x);
+  const float d = vec3_length(to_camera);
+  return d > 0.0f ? vec3_scale(to_camera, 1.0f / d) : vec3_scale(vec3_from4(s->camera.forward), -1.0f);
+}
+
 /* The direction path k looks along, ω: uniform on the sphere (pdf 1/4π: the mean radiance is R and
  * −3·L·ω estimates b), or for MS_CACHE_CLOSURE_CAMERA the reverse of a propagation direction w
- * drawn from the phase function about w_c, the direction from x to the camera (the mean radiance is
- * then the in-scattering towards the camera; ms_cache.h, "Closure"). A node at the camera's very
- * position takes w_c = −forward. */
-static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int closure, vec3 x, float u1, float u2) {
+ * drawn from the phase function about w_c (the mean radiance is then the in-scattering towards the
+ * camera; ms_cache.h, "Closure"). ω is then the direction a camera path arriving at x along −w_c
+ * would scatter into, drawn as the path tracer draws it, with density *pdf. */
+static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int closure, vec3 x, float u1, float u2,
+                                      NV_PRIVATE float* pdf) {
   switch (closure) {
     case MS_CACHE_CLOSURE_LINEAR:
-    case MS_CACHE_CLOSURE_HG: return sample_uniform_sphere(u1, u2);
-    case MS_CACHE_CLOSURE_CAMERA: {
-      const vec3 to_camera = vec3_sub(vec3_from4(s->camera.position), x);
-      const float d = vec3_length(to_camera);
-      const vec3 w_c = d > 0.0f ? vec3_scale(to_camera, 1.0f / d) : vec3_scale(vec3_from4(s->camera.forward), -1.0f);
-      float pdf;
-      return vec3_scale(phase_sample(s->medium.phase, s->medium.g, w_c, u1, u2, &pdf), -1.0f);
-    }
-    default: return sample_uniform_sphere(u1, u2); /* unknown: reported at the kernel's entry */
+    case MS_CACHE_CLOSURE_HG: *pdf = 0.25f * NV_INV_PI; return sample_uniform_sphere(u1, u2);
+    case MS_CACHE_CLOSURE_CAMERA:
+      return vec3_scale(phase_sample(s->medium.phase, s->medium.g, ms_cache_to_camera(s, x), u1, u2, pdf), -1.0f);
+    default: *pdf = 0.0f; return sample_uniform_sphere(u1, u2); /* unknown: reported at the kernel's entry */
   }
 }
 
-/* Path k's estimate at node `node`, at world point x: the radiance of the rest arriving along a
- * direction drawn by ms_cache_direction, and the direction ω it looked along. */
-static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, int closure, int direct, vec3 x, int node, uint k,
-                                 NV_PRIVATE vec3* omega) {
+/* Path k's estimate at node `node`, at world point x (a grid node's; a view node's path draws its
+ * own in the node's slice, ms_cache_view.h): the radiance of the rest arriving along a direction
+ * drawn by ms_cache_direction, and the direction ω it looked along. With the direct
+ * light (ms_cache.h, "Direct") the node is a scattering event of a camera path arriving along −w_c:
+ * the path tracer's next-event estimate there, and the emitter the first segment meets weighted
+ * against it by MIS, as at any event of a path-traced pixel. */
+static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
+                                 NV_GLOBAL const float* v, vec3 x, uint k, NV_PRIVATE vec3* omega) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
+  const int view = rp->ms_cache_layout == MS_CACHE_LAYOUT_VIEW, direct = rp->ms_cache_direct;
+  const int closure = rp->ms_cache_closure; /* the camera closure in the view layout (the host sets it) */
   rng_state rng = rng_init(s->seed + MS_CACHE_SEED_OFFSET, (uint)node, k);
+  if (view) x = ms_view_sample_point(KERNEL_CONTEXT_ARG, rp, node, v, rng_uniform(&rng)); /* in its slice */
   const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
-  *omega = ms_cache_direction(s, closure, x, u1, u2);
-  const vec3 L = pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, &rng); /* ms_cache.h, "Direct" */
+  float pdf;
+  *omega = ms_cache_direction(s, closure, x, u1, u2, &pdf);
+  vec3 L = vec3_splat(0.0f);
+  if (direct) L = pathtrace_direct(KERNEL_CONTEXT_ARG, x, vec3_scale(ms_cache_to_camera(s, x), -1.0f), &rng);
+  L = vec3_add(L, pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, direct ? pdf : 0.0f, &rng));
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);
@@ -79,11 +92,11 @@ static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
 /* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"), the
  * node at world point x: v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then
  * ln R and b/R. */
-static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, int closure, int direct, vec3 x, int node,
-                                        NV_GLOBAL float* v, uint first, uint count) {
+static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, vec3 x,
+                                        int node, NV_GLOBAL float* v, uint first, uint count) {
   for (uint k = first; k < first + count; ++k) {
     vec3 omega;
-    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, closure, direct, x, node, k, &omega);
+    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, rp, node, v, x, k, &omega);
     const float n = (float)(k + 1u);
     const float Lc[3] = {L.x, L.y, L.z};
     const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */
@@ -104,21 +117,20 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, int closure, int d
 
 /* One launch's work for node `node` (ms_cache.cl): paths [first, first + count) at the node's point,
  * for the cache's layout. A grid node no lookup reads is left at 0 (ms_cache_node_is_read); a view
- * node sits where ms_view_place_column put it, and takes no paths when its column holds no medium. */
+ * node's slice is where ms_view_place_column put it, and it takes no paths when its column holds no
+ * medium. */
 static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
                                        NV_GLOBAL float* v, uint first, uint count) {
   NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
   switch (rp->ms_cache_layout) {
     case MS_CACHE_LAYOUT_GRID:
       if (ms_cache_node_is_read(KERNEL_CONTEXT_ARG, c, node))
-        ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp->ms_cache_closure, rp->ms_cache_direct,
+        ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp,
                              affine_point(c->index_to_world, node_grid_point(c, vec3_from4(ctx->medium->dims), node)),
                              node, v, first, count);
       return;
-    case MS_CACHE_LAYOUT_VIEW: /* placed once per cache by ms_cache_place_view */
-      if (v[MS_VIEW_TAU] >= 0.0f)
-        ms_cache_refine_node(KERNEL_CONTEXT_ARG, MS_CACHE_CLOSURE_CAMERA, rp->ms_cache_direct,
-                             ms_view_node_point(ctx->scene, rp, node, v), node, v, first, count);
+    case MS_CACHE_LAYOUT_VIEW: /* placed once per cache by ms_cache_place_view; each path draws its point */
+      if (v[MS_VIEW_TAU] >= 0.0f) ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp, vec3_splat(0.0f), node, v, first, count);
       return;
     default: return; /* unknown: reported at the kernel's entry */
   }

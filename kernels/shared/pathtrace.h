@@ -91,16 +91,18 @@ static inline vec3 pathtrace_direct(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, NV_
 /* Radiance arriving at o from the direction −d, by one path: the ray o + t·d, then up to max_bounces
  * real scattering events. unscattered_emitters 0 drops the emitter the first segment may hit (the
  * unscattered light of the lights, which the ray marcher adds itself: the multiple-scattering
- * cache, ms_cache.h); the background seen through the medium is kept either way. Non-finite
- * results are left to the caller's check. */
+ * cache, ms_cache.h); the background seen through the medium is kept either way. first_phase_pdf:
+ * 0 when o is the camera; else o is a scattering event whose next-event estimate the caller made
+ * and d was drawn from the phase function with this density, which weights (MIS) an emitter the
+ * first segment hits, as at every later event. Non-finite results are left to the caller's check. */
 static inline vec3 pathtrace_radiance(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, int unscattered_emitters,
-                                      NV_PRIVATE rng_state* rng_in) {
+                                      float first_phase_pdf, NV_PRIVATE rng_state* rng_in) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
   NV_PRIVATE uint* status = &ctx->status;
   rng_state rng = *rng_in;
   vec3 L = vec3_splat(0.0f), beta = vec3_splat(1.0f);
-  float prev_phase_pdf = 0.0f; /* 0: the ray left the camera, no MIS on what it hits */
+  float prev_phase_pdf = first_phase_pdf; /* 0: the ray left the camera, no MIS on what it hits */
   int depth = 0;
   /* Bounded without a cap of its own: every iteration either ends the path (break) or is a real
    * scattering event that takes depth one closer to max_bounces (checked before the increment, so
@@ -159,7 +161,7 @@ static inline vec3 pathtrace_sample(KERNEL_CONTEXT_PARAM, int px, int py, uint s
   const float jx = rng_uniform(&rng), jy = rng_uniform(&rng);
   const float lu = rng_uniform(&rng), lv = rng_uniform(&rng);
   const ray3 cam = camera_ray(&s->camera, (float)px + jx, (float)py + jy, lu, lv);
-  const vec3 L = pathtrace_radiance(KERNEL_CONTEXT_ARG, cam.origin, cam.dir, 1, &rng);
+  const vec3 L = pathtrace_radiance(KERNEL_CONTEXT_ARG, cam.origin, cam.dir, 1, 0.0f, &rng);
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
     return vec3_splat(0.0f);

@@ -162,9 +162,6 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
       {"renderer.raymarch.msCache.direct=true",
        "narval: s.json: renderer.raymarch.msCache.direct: needs closure \"camera\" or layout \"view\" (a node must "
        "hold the light scattered towards the camera)\n"},
-      {"renderer.raymarch.msCache.direct=true --set renderer.raymarch.msCache.layout=\\\"view\\\"",
-       "narval: s.json: renderer.raymarch.msCache.direct: needs rectangle lights: point light \"point\" is never met by "
-       "the cache's paths\n"},
       {"renderer.raymarch.msCache.tile=0", "narval: s.json: renderer.raymarch.msCache.tile: must be at least 1, got 0\n"},
       {"renderer.raymarch.msCache.slices=1",
        "narval: s.json: renderer.raymarch.msCache.slices: must be at least 2, got 1\n"},

@@ -402,35 +402,39 @@ TEST(MsCache, CameraClosureMatchesThePathTracerForAForwardPhaseFunction) {
 }
 
 // The view layout (ms_cache_view.h) holds the same in-scattering towards the camera as the closure
-// "camera", at nodes along each column's optical depth instead of a grid's corners, and its
-// lookup's errors are again second order: bilinear between columns (a smooth field over the image)
-// and linear in τ between slices. Halving the tile and the slice spacing together (tile 2 → 1
-// pixel, 8 → 15 slices: the levels T_s of 15 slices are those of 8 and the midpoints between them)
-// quarters them, so the isotropic test's Richardson bound applies unchanged. HG g = 0.8 as above,
+// "camera", as means over slices of each column's optical depth instead of values at a grid's
+// corners. Its lookup is bilinear between columns (second order for a smooth field over the image)
+// and takes the slice that holds the sample's τ: exact in τ for a pixel whose J(τ) is its column's
+// (the weight e^{−τ}dτ does not depend on the geometry), up to the march's steps that straddle a
+// slice's end. Halving the tile and the slice width together (tile 2 → 1 pixel, 8 → 16 slices)
+// shrinks both, and the isotropic test's Richardson bound is used unchanged. HG g = 0.8 as above,
 // where the linear closure falls outside it on most tile channels (measured 42 of 48). The widest
-// bound, 19.3% of the value (asserted ≤ 25%), is at the darkest corner tile, where the noise of
-// one-pixel columns is most of it (4σ ≈ 11% of the value there); at tile 4 → 2 the difference
-// between the two resolutions widens it to 21.9%.
+// bound, 14.0% of the value (asserted ≤ 25%), is at the darkest corner tile, where the noise of
+// one-pixel columns is most of it.
 TEST(MsCache, ViewLayoutMatchesThePathTracerForAForwardPhaseFunction) {
   const LitBoxCheck c = checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8)",
-                                    R"("layout": "view", "tile": 1, "slices": 15)", "cache", R"("resolution": 8)");
+                                    R"("layout": "view", "tile": 1, "slices": 16)", "cache", R"("resolution": 8)");
   expectLitBox(c, "HG 0.8, layout view", "the linear closure", 0.25, 0.5);
 }
 
-// With msCache.direct the view layout's nodes hold the lights' unscattered light as well, from the
-// paths' first segments that meet the light (ms_cache.h, "Direct"), and the march adds no light
-// loop: every scattering order then comes from the cache, and the same Richardson bound applies
-// (the lookup's errors are those of the in-scattering it interpolates). A rectangle light (a point
-// is never met), HG 0.8. The linear closure, whose single scattering the march computes, falls
-// outside the bound on most tile channels (measured 36 of 48), so the bound can tell. The widest
-// bound is 25.6% of the value (asserted ≤ 30%): the direct light met by phase-sampled paths is the
-// noisiest part of a node (measured worst |error|/bound 0.49).
+// With msCache.direct the view layout's nodes hold the lights' unscattered light as well: each path
+// makes the path tracer's next-event estimate at its start and counts the light its first segment
+// meets under MIS (ms_cache.h, "Direct"), and the march adds no light loop. Every scattering order
+// then comes from the cache, and the same Richardson bound applies. Both kinds of light: a
+// rectangle (met by the first segments and by the shadow rays) and the point light (by the shadow
+// rays alone). The linear closure, whose single scattering the march computes, falls outside the
+// bound on most tile channels (measured 48 and 42 of 48), so the bound can tell. The widest bounds
+// are 21.4% and 22.9% of the value (asserted ≤ 30%).
 TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracer) {
-  const LitBoxCheck c =
+  const LitBoxCheck rect =
       checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
-                  R"("layout": "view", "tile": 1, "slices": 15, "direct": true)", "cache", R"("resolution": 8)",
+                  R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", "cache", R"("resolution": 8)",
                   kLitBoxPanel);
-  expectLitBox(c, "HG 0.8, rectangle light, layout view with the direct light", "the linear closure", 0.3, 0.5);
+  expectLitBox(rect, "HG 0.8, rectangle light, layout view with the direct light", "the linear closure", 0.3, 0.5);
+  const LitBoxCheck point =
+      checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
+                  R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", "cache", R"("resolution": 8)");
+  expectLitBox(point, "HG 0.8, point light, layout view with the direct light", "the linear closure", 0.3, 0.5);
 }
 
 }  // namespace

@@ -68,22 +68,29 @@ TEST(MsCacheView, PixelsFindTheirColumnsBilinearly) {
   for (int k = 1; k < 4; ++k) EXPECT_EQ(cols.column[k] == 0 || cols.w[k] == 0.0f, true);
 }
 
-// Along a column the value is linear in τ between slices: a field linear in τ (and bilinear across
-// columns) is read exactly at any τ inside the nodes' range, clamped at the ends outside it.
-TEST(MsCacheView, ColumnsAreReadLinearlyInOpticalDepth) {
+// Along a column each slice [τ_s, τ_{s+1}) gives its node's value (the slice's mean; ms_cache_view.h,
+// "A node holds the slice's mean"): a sample before the first slice reads it, one past the last
+// start reads the last; across columns the values mix bilinearly.
+TEST(MsCacheView, ColumnsAreReadSliceBySliceInOpticalDepth) {
   const realtime_params rp = viewParams(2, 2, 4, 4);
   auto tau = [](int cx, int cy, int s) { return 0.5f * float(s * s) + 0.1f * float(cx + cy); };  // uneven spacing
-  auto value = [](int cx, int cy, int s) { return 2.0f + 3.0f * (0.5f * float(s * s) + 0.1f * float(cx + cy)); };
+  auto value = [](int cx, int cy, int s) { return 2.0f + 3.0f * float(s) + 10.0f * float(cx + 2 * cy); };
   const std::vector<float> cache = viewCache(rp.ms_cache, tau, value);
-  // Pixel (1, 1) of the 8x8 image: u = 1.5/4 − 0.5 < 0 → column (0, 0) alone; f(τ) = 2 + 3τ.
+  // Pixel (1, 1) of the 8x8 image: u = 1.5/4 − 0.5 < 0 → column (0, 0) alone, slice starts 0, 0.5, 2, 4.5.
   const ms_view_columns corner = ms_view_locate(&rp, 1, 1);
-  for (float t : {0.0f, 0.2f, 0.5f, 1.3f, 2.0f, 3.7f, 4.5f})
-    EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, t).y, 2.0f + 3.0f * t, 1e-5f) << t;
-  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, -1.0f).x, 2.0f, 1e-6f);  // before node 0
-  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, 9.0f).z, 2.0f + 3.0f * 4.5f, 1e-5f);  // past 3
-  // Pixel (3, 4): between all four columns; each reads 2 + 3τ at the same τ (in range for all).
+  const float expected[][2] = {{-1.0f, 2}, {0.0f, 2}, {0.49f, 2}, {0.5f, 5}, {1.99f, 5}, {2.0f, 8}, {4.49f, 8},
+                               {4.5f, 11}, {9.0f, 11}};
+  for (const auto& e : expected) EXPECT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, e[0]).y, e[1]) << e[0];
+  // Pixel (3, 4): u = (0.375, 0.625), weights 0.625·0.375, 0.375·0.375, 0.625·0.625, 0.375·0.625 on
+  // columns (0,0), (1,0), (0,1), (1,1). At τ = 1 column (0,0) is in slice 1 (starts 0, 0.5, 2), (1,0)
+  // and (0,1) too (0.1, 0.6, 2.1), (1,1) too (0.2, 0.7, 2.2): 5 + 10·(0.375 + 2·0.625 … ) bilinear.
   const ms_view_columns mid = ms_view_locate(&rp, 3, 4);
-  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 1.0f).x, 5.0f, 1e-5f);
+  const float bilinear = 5.0f + 10.0f * (0.375f + 2.0f * 0.625f);
+  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 1.0f).x, bilinear, 1e-5f);
+  // At τ = 0.55 column (0,0) is in slice 1 (0.5 ≤ τ) and the others still in slice 0 (0.6, 0.6, 0.7).
+  const float mixed = 0.625f * 0.375f * 5.0f + 0.375f * 0.375f * 12.0f + 0.625f * 0.625f * 22.0f +
+                      0.375f * 0.625f * 32.0f;
+  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 0.55f).x, mixed, 1e-5f);
 }
 
 // A column whose ray meets no medium (τ = −1) drops out and the others' weights are renormalised;
@@ -102,13 +109,15 @@ TEST(MsCacheView, ColumnsWithoutMediumDropOut) {
 
 // Placement in a homogeneous cube [−½, ½]³ of σt = 6 (grey), seen from (0, 0, −4) at 30°: along a
 // column's ray τ(t) = 6·(t − t0) exactly (the march's linear τ within a step is then exact), so
-// node s sits at t_s = t0 + level_s/6, level_s = −ln(1 − (1 − T_end)·s/(nz − 1)) with T_end =
-// max(e^{−τ_end}, 0.01) ("Layout"); τ_end = 6·(t1 − t0) ≈ 6 passes τ_max = ln 100 = 4.61, so the
-// last node lies at τ_max, inside the cube. In the 8x8 image at tile 2 the inner four columns'
-// rays (pixel centres 3 and 5: 0.25 of the half-width, 0.23 world units off the axis at the front
-// face) cross the cube front to back; the outer twelve (0.75: 0.70 off it) miss it and hold τ = −1.
-// Tolerance 1e-4 world units: 256 float steps of τ.
-TEST(MsCacheView, NodesSitAtEqualStepsOfTheCamerasTransmittance) {
+// level i lies at t_i = t0 + level_i/6, level_i = −ln(1 − (1 − T_end)·i/nz) with T_end =
+// max(e^{−τ_end}, 0.01) ("Layout"), and node s spans levels s and s + 1; τ_end = 6·(t1 − t0) ≈ 6
+// passes τ_max = ln 100 = 4.61, so the last slice ends at τ_max, inside the cube. In the 8x8 image
+// at tile 2 the inner four columns' rays (pixel centres 3 and 5: 0.25 of the half-width, 0.23
+// world units off the axis at the front face) cross the cube front to back; the outer twelve
+// (0.75: 0.70 off it) miss it and hold τ = −1. Tolerance 1e-4 world units: 256 float steps of τ.
+// A path's start drawn with u lies at τ_s − ln(1 − u·(1 − e^{−(τ_{s+1} − τ_s)})) (T uniform over
+// the slice): at t0 + that/6, within the slice march's 16 steps' rounding (1e-4).
+TEST(MsCacheView, SlicesEndAtEqualStepsOfTheCamerasTransmittance) {
   const Scene scene = parseScene(R"({
     "materials": [{"name": "m", "type": "volume", "scattering": [5, 5, 5], "absorption": [1, 1, 1]}],
     "primitives": [{"name": "v", "type": "volume", "transform": {"scale": [1, 1, 1]}, "materialName": "m"}],
@@ -139,19 +148,26 @@ TEST(MsCacheView, NodesSitAtEqualStepsOfTheCamerasTransmittance) {
     ASSERT_EQ(t0 < t1, inner) << "column " << column;
     crossing += inner;
     const double tEnd = std::max(std::exp(-6.0 * (t1 - t0)), 0.01);
+    auto level = [&](int i) { return -std::log(1.0 - (1.0 - tEnd) * i / 5.0); };
     for (int s = 0; s < 5; ++s) {
-      const float* v = cache.data() + size_t(column + 16 * s) * MS_CACHE_STRIDE;
+      const int node = column + 16 * s;
+      const float* v = cache.data() + size_t(node) * MS_CACHE_STRIDE;
       if (!inner) {
         EXPECT_EQ(v[MS_VIEW_TAU], -1.0f) << "column " << column << " slice " << s;
         continue;
       }
-      const double level = -std::log(1.0 - (1.0 - tEnd) * s / 4.0);
-      EXPECT_NEAR(v[MS_VIEW_TAU], level, 1e-5) << "column " << column << " slice " << s;
-      EXPECT_NEAR(v[MS_VIEW_T], t0 + level / 6.0, 1e-4) << "column " << column << " slice " << s;
-      const vec3 x = ms_view_node_point(&ds.params, &rp, column + 16 * s, v);
-      EXPECT_NEAR(x.z, r.origin.z + r.dir.z * (t0 + level / 6.0), 1e-4) << "column " << column << " slice " << s;
+      EXPECT_NEAR(v[MS_VIEW_TAU], level(s), 1e-5) << "column " << column << " slice " << s;
+      EXPECT_NEAR(v[MS_VIEW_TAU_END], level(s + 1), 1e-5) << "column " << column << " slice " << s;
+      EXPECT_NEAR(v[MS_VIEW_T], t0 + level(s) / 6.0, 1e-4) << "column " << column << " slice " << s;
+      EXPECT_NEAR(v[MS_VIEW_T_END], t0 + level(s + 1) / 6.0, 1e-4) << "column " << column << " slice " << s;
+      for (float u : {0.0f, 0.3f, 0.8f}) {
+        const double tau = level(s) - std::log(1.0 - u * (1.0 - std::exp(level(s) - level(s + 1))));
+        const vec3 x = ms_view_sample_point(narval::test::sceneContext(&ds.params, ds.lights.data(), &homogeneous),
+                                            &rp, node, v, u);
+        EXPECT_NEAR(x.z, r.origin.z + r.dir.z * (t0 + tau / 6.0), 1e-4) << "column " << column << " slice " << s;
+      }
     }
-    if (inner) EXPECT_LT(t0 + std::log(100.0) / 6.0, t1);  // the deepest node is capped at τ_max, inside
+    if (inner) EXPECT_LT(t0 + std::log(100.0) / 6.0, t1);  // the last slice ends at τ_max, inside
   }
   EXPECT_EQ(crossing, 4);
 }
