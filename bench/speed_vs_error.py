@@ -17,6 +17,10 @@ parameters and sweeps (full mode; each sweep varies one parameter from the base)
                     image, nodes along their optical depth), the phase over rectangles exact and their
                     shadows weighted by the phase: msCache.tile 2,4,8 (base 4); msCache.slices 4,8,16
                     (base 8); msCache.paths 64,256,1024 (base 256); shadowWeighting area,phase (base phase)
+  raymarch-cache-direct  the view-space cache holding the lights' unscattered light too
+                    (msCache.direct: its paths make the path tracer's next-event estimate at their
+                    start; the march makes no light loop): msCache.tile 2,4 (base 2); msCache.slices
+                    4,8 (base 8); msCache.paths 128,256,512 (base 256)
   lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
   lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
 Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
@@ -111,6 +115,11 @@ METHODS = {
                             "base": {"msCache.tile": 4, "msCache.slices": 8, "msCache.paths": 256,
                                      "shadowWeighting": "phase"},
                             "style": ("diamond", "#e6ab02")},
+    "raymarch-cache-direct": {"algorithm": "raymarch",
+                              "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.layout": "view",
+                                           "msCache.direct": True},
+                              "base": {"msCache.tile": 2, "msCache.slices": 8, "msCache.paths": 256},
+                              "style": ("triangle-down", "#666666")},
     "lobe-eq7": {"algorithm": "lobe", "settings": {"variant": "eq7"}, "base": {}, "style": ("triangle", "#1b9e77")},
     "lobe-corrected": {"algorithm": "lobe", "settings": {"variant": "corrected"}, "base": {"viewSteps": 16},
                        "style": ("cross", "#7570b3")},
@@ -128,6 +137,7 @@ FULL_SWEEPS = {
                               "areaLightPhase": ["points", "exact"], "msCache.interpolation": ["geometric", "linear"]},
     "raymarch-cache-view": {"msCache.tile": [2, 4, 8], "msCache.slices": [4, 8, 16], "msCache.paths": [64, 256, 1024],
                             "shadowWeighting": ["area", "phase"]},
+    "raymarch-cache-direct": {"msCache.tile": [2, 4], "msCache.slices": [4, 8], "msCache.paths": [128, 256, 512]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},
@@ -139,6 +149,7 @@ QUICK_SWEEPS = {
     "raymarch-cache": {"msCache.resolution": [8, 16], "msCache.paths": [64, 256], "steps": [30, 60]},
     "raymarch-cache-camera": {"msCache.resolution": [8, 16], "msCache.paths": [64, 256]},
     "raymarch-cache-view": {"msCache.tile": [4, 8], "msCache.paths": [16, 64]},
+    "raymarch-cache-direct": {"msCache.tile": [4, 8], "msCache.paths": [16, 64]},
     "lobe-eq7": {"lobePoints": [10, 30], "depthFactor": [5, 100], "shadowSteps": [25, 100]},
     "lobe-corrected": {"lobePoints": [10, 30], "lobeRadius": [0.3, 3], "viewSteps": [8, 16]},
 }
