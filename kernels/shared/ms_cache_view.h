@@ -193,11 +193,23 @@ static inline ms_view_columns ms_view_locate(NV_CONSTANT const realtime_params* 
   return cols;
 }
 
-/* The in-scattering towards the camera per unit σs at grey optical depth tau, for the pixel whose
- * columns are `cols` ("Lookup"); 0 where none of them holds medium. */
+/* 1 − e^{−x} for x ≥ 0, accurate for small x (march_step_weight's series). */
+static inline float ms_view_one_minus_exp(float x) { return x * march_step_weight(x, nv_exp(-x)); }
+
+/* The in-scattering towards the camera per unit σs over a march step from grey optical depth tau
+ * to tau + dtau, for the pixel whose columns are `cols` ("Lookup"); 0 where none of them holds
+ * medium. Each column's slices make J(τ) piecewise constant, so the step's mean under the weight
+ * it gets in the step, e^{−(τ − tau)} (the energy-conserving step's, march.h), is exact:
+ *   J_step = Σ_s J̄_s·(e^{−(lo_s − tau)} − e^{−(hi_s − tau)}) / (1 − e^{−dtau}),
+ * [lo_s, hi_s] the part of slice s inside the step (the first slice reaching back to 0, the last
+ * on to ∞). A point read at the step's middle was a quadrature of its own: 60 steps through the
+ * back-lit Disney cloud cross several slices each near its surface (JND 8.7% against 8.0% at 120
+ * steps). The weight is the grey τ's; a chromatic medium's channels fall at their own rates within
+ * a step. dtau = 0 reads the slice holding tau. */
 static inline vec3 ms_view_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
-                                  NV_PRIVATE const ms_view_columns* cols, float tau) {
+                                  NV_PRIVATE const ms_view_columns* cols, float tau, float dtau) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
+  const float end = tau + dtau;
   vec3 sum = vec3_splat(0.0f);
   float weight = 0.0f;
   for (int k = 0; k < 4; ++k) {
@@ -205,8 +217,24 @@ static inline vec3 ms_view_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOB
     if (!(cols->w[k] > 0.0f) || col[MS_VIEW_TAU] < 0.0f) continue;
     int s = 0;
     while (s + 1 < c->nz && col[(size_t)(s + 1) * slice_stride + MS_VIEW_TAU] <= tau) ++s;
-    NV_GLOBAL const float* v = col + (size_t)s * slice_stride;
-    sum = vec3_add(sum, vec3_scale(vec3_make(v[0], v[1], v[2]), cols->w[k]));
+    vec3 J = vec3_splat(0.0f);
+    if (end > tau) {
+      float lo = tau, total = 0.0f; /* the step's part inside slice s starts at lo */
+      for (;; ++s) {
+        NV_GLOBAL const float* v = col + (size_t)s * slice_stride;
+        const float hi = s + 1 < c->nz ? nv_fmin(col[(size_t)(s + 1) * slice_stride + MS_VIEW_TAU], end) : end;
+        const float w = nv_exp(tau - lo) * ms_view_one_minus_exp(hi - lo);
+        J = vec3_add(J, vec3_scale(vec3_make(v[0], v[1], v[2]), w));
+        total += w; /* telescopes to 1 − e^{−(end − tau)}, in the pieces' own rounding */
+        if (!(hi < end)) break;
+        lo = hi;
+      }
+      J = vec3_scale(J, 1.0f / total);
+    } else {
+      NV_GLOBAL const float* v = col + (size_t)s * slice_stride;
+      J = vec3_make(v[0], v[1], v[2]);
+    }
+    sum = vec3_add(sum, vec3_scale(J, cols->w[k]));
     weight += cols->w[k];
   }
   return weight > 0.0f ? vec3_scale(sum, 1.0f / weight) : sum;

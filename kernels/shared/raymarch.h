@@ -133,18 +133,18 @@ typedef struct raymarch_accum {
   vec3 L, T;
 } raymarch_accum;
 
-/* The multiple-scattering cache's in-scattering towards the camera per unit σs at sample point x
- * (world; p in index space), at grey optical depth tau from the camera along the view ray, for the
- * pixel whose view-space columns are `cols` (ms_cache.h for the grid layout, ms_cache_view.h for the
- * view layout). */
+/* The multiple-scattering cache's in-scattering towards the camera per unit σs for the march step
+ * at index-space point p (its middle), from grey optical depth tau to tau + dtau along the view ray:
+ * the grid layout's at p (ms_cache.h), the view layout's over the step for the pixel whose columns
+ * are `cols` (ms_cache_view.h). */
 static inline vec3 raymarch_ms_cache(NV_CONSTANT const realtime_params* rp, NV_CONSTANT const medium_params* m,
                                      NV_GLOBAL const float* ms_cache, NV_PRIVATE const ms_view_columns* cols, vec3 p,
-                                     float tau, vec3 dir) {
+                                     float tau, float dtau, vec3 dir) {
   switch (rp->ms_cache_layout) {
     case MS_CACHE_LAYOUT_GRID:
       return ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), p, phase_mean_cosine(m->phase, m->g),
                              rp->ms_cache_closure, rp->ms_cache_interpolation, vec3_scale(dir, -1.0f));
-    case MS_CACHE_LAYOUT_VIEW: return ms_view_lookup(&rp->ms_cache, ms_cache, cols, tau);
+    case MS_CACHE_LAYOUT_VIEW: return ms_view_lookup(&rp->ms_cache, ms_cache, cols, tau, dtau);
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
   }
 }
@@ -182,8 +182,8 @@ static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const real
       vec3 Li = rp->ms_cache.nx > 0 && rp->ms_cache_direct
                     ? vec3_splat(0.0f)
                     : raymarch_light_sum(KERNEL_CONTEXT_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir);
-      if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h), at the step's middle */
-        Li = vec3_add(Li, raymarch_ms_cache(rp, m, ms_cache, cols, vec3_madd(seg->o, seg->d, t), tau + 0.5f * dtau, dir));
+      if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h), over the step */
+        Li = vec3_add(Li, raymarch_ms_cache(rp, m, ms_cache, cols, vec3_madd(seg->o, seg->d, t), tau, dtau, dir));
       S = vec3_mul(sigma_s, Li);
     }
     tau += dtau;

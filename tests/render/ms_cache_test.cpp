@@ -404,13 +404,13 @@ TEST(MsCache, CameraClosureMatchesThePathTracerForAForwardPhaseFunction) {
 // The view layout (ms_cache_view.h) holds the same in-scattering towards the camera as the closure
 // "camera", as means over slices of each column's optical depth instead of values at a grid's
 // corners. Its lookup is bilinear between columns (second order for a smooth field over the image)
-// and takes the slice that holds the sample's τ: exact in τ for a pixel whose J(τ) is its column's
-// (the weight e^{−τ}dτ does not depend on the geometry), up to the march's steps that straddle a
-// slice's end. Halving the tile and the slice width together (tile 2 → 1 pixel, 8 → 16 slices)
-// shrinks both, and the isotropic test's Richardson bound is used unchanged. HG g = 0.8 as above,
-// where the linear closure falls outside it on most tile channels (measured 42 of 48). The widest
-// bound, 14.0% of the value (asserted ≤ 25%), is at the darkest corner tile, where the noise of
-// one-pixel columns is most of it.
+// and integrates each column's piecewise-constant J over the march step's τ exactly: exact in τ for
+// a pixel whose J(τ) is its column's (the weight e^{−τ}dτ does not depend on the geometry). Halving
+// the tile and the slice width together (tile 2 → 1 pixel, 8 → 16 slices) shrinks what is left,
+// and the isotropic test's Richardson bound is used unchanged. HG g = 0.8 as above, where the
+// linear closure falls outside it on most tile channels (measured 42 of 48). The widest bound,
+// 13.9% of the value (asserted ≤ 25%), is at the darkest corner tile, where the noise of one-pixel
+// columns is most of it.
 TEST(MsCache, ViewLayoutMatchesThePathTracerForAForwardPhaseFunction) {
   const LitBoxCheck c = checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8)",
                                     R"("layout": "view", "tile": 1, "slices": 16)", "cache", R"("resolution": 8)");
@@ -424,7 +424,7 @@ TEST(MsCache, ViewLayoutMatchesThePathTracerForAForwardPhaseFunction) {
 // rectangle (met by the first segments and by the shadow rays) and the point light (by the shadow
 // rays alone). The linear closure, whose single scattering the march computes, falls outside the
 // bound on most tile channels (measured 48 and 42 of 48), so the bound can tell. The widest bounds
-// are 21.4% and 22.9% of the value (asserted ≤ 30%).
+// are 21.6% and 22.9% of the value (asserted ≤ 30%).
 TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracer) {
   const LitBoxCheck rect =
       checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",

@@ -80,17 +80,39 @@ TEST(MsCacheView, ColumnsAreReadSliceBySliceInOpticalDepth) {
   const ms_view_columns corner = ms_view_locate(&rp, 1, 1);
   const float expected[][2] = {{-1.0f, 2}, {0.0f, 2}, {0.49f, 2}, {0.5f, 5}, {1.99f, 5}, {2.0f, 8}, {4.49f, 8},
                                {4.5f, 11}, {9.0f, 11}};
-  for (const auto& e : expected) EXPECT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, e[0]).y, e[1]) << e[0];
+  for (const auto& e : expected) EXPECT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, e[0], 0.0f).y, e[1]) << e[0];
   // Pixel (3, 4): u = (0.375, 0.625), weights 0.625·0.375, 0.375·0.375, 0.625·0.625, 0.375·0.625 on
   // columns (0,0), (1,0), (0,1), (1,1). At τ = 1 column (0,0) is in slice 1 (starts 0, 0.5, 2), (1,0)
   // and (0,1) too (0.1, 0.6, 2.1), (1,1) too (0.2, 0.7, 2.2): 5 + 10·(0.375 + 2·0.625 … ) bilinear.
   const ms_view_columns mid = ms_view_locate(&rp, 3, 4);
   const float bilinear = 5.0f + 10.0f * (0.375f + 2.0f * 0.625f);
-  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 1.0f).x, bilinear, 1e-5f);
+  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 1.0f, 0.0f).x, bilinear, 1e-5f);
   // At τ = 0.55 column (0,0) is in slice 1 (0.5 ≤ τ) and the others still in slice 0 (0.6, 0.6, 0.7).
   const float mixed = 0.625f * 0.375f * 5.0f + 0.375f * 0.375f * 12.0f + 0.625f * 0.625f * 22.0f +
                       0.375f * 0.625f * 32.0f;
-  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 0.55f).x, mixed, 1e-5f);
+  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 0.55f, 0.0f).x, mixed, 1e-5f);
+}
+
+// A march step from τ to τ + Δτ reads each column's piecewise-constant J weighted by e^{−(τ' − τ)}
+// over the step, normalised by 1 − e^{−Δτ} (the weight the energy-conserving step gives it):
+// column (0, 0) of the cache above has slices from 0, 0.5, 2, 4.5 holding 2, 5, 8, 11.
+//  - [0.3, 0.8] crosses 0.5: (2·(1 − e^{−0.2}) + 5·e^{−0.2}(1 − e^{−0.3}))/(1 − e^{−0.5});
+//  - [4, 6] crosses 4.5 into the last slice, which runs on: (8·(1 − e^{−0.5}) + 11·e^{−0.5}(1 − e^{−1.5}))/(1 − e^{−2});
+//  - a step inside one slice reads its value, and a tiny step the slice it starts in.
+TEST(MsCacheView, AStepReadsItsSlicesWeightedByItsOwnAttenuation) {
+  const realtime_params rp = viewParams(2, 2, 4, 4);
+  auto tau = [](int cx, int cy, int s) { return 0.5f * float(s * s) + 0.1f * float(cx + cy); };
+  auto value = [](int cx, int cy, int s) { return 2.0f + 3.0f * float(s) + 10.0f * float(cx + 2 * cy); };
+  const std::vector<float> cache = viewCache(rp.ms_cache, tau, value);
+  const ms_view_columns corner = ms_view_locate(&rp, 1, 1);
+  auto read = [&](float t, float dt) { return double(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, t, dt).x); };
+  const double e = std::exp(1.0);
+  EXPECT_NEAR(read(0.3f, 0.5f), (2 * (1 - std::pow(e, -0.2)) + 5 * std::pow(e, -0.2) * (1 - std::pow(e, -0.3))) /
+                                    (1 - std::pow(e, -0.5)), 1e-5);
+  EXPECT_NEAR(read(4.0f, 2.0f), (8 * (1 - std::pow(e, -0.5)) + 11 * std::pow(e, -0.5) * (1 - std::pow(e, -1.5))) /
+                                    (1 - std::pow(e, -2.0)), 1e-5);
+  EXPECT_NEAR(read(0.6f, 1.0f), 5.0, 1e-5);
+  EXPECT_NEAR(read(1.9f, 1e-7f), 5.0, 1e-4);
 }
 
 // A column whose ray meets no medium (τ = −1) drops out and the others' weights are renormalised;
@@ -102,9 +124,9 @@ TEST(MsCacheView, ColumnsWithoutMediumDropOut) {
   std::vector<float> cache = viewCache(rp.ms_cache, tau, value);
   const ms_view_columns cols = ms_view_locate(&rp, 3, 0);  // between the two columns
   EXPECT_GT(cols.w[0], 0.0f);
-  EXPECT_FLOAT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &cols, 0.5f).x, 7.0f);
+  EXPECT_FLOAT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &cols, 0.5f, 0.0f).x, 7.0f);
   for (int s = 0; s < 2; ++s) cache[size_t(1 + 2 * s) * MS_CACHE_STRIDE + MS_VIEW_TAU] = -1.0f;
-  EXPECT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &cols, 0.5f).x, 0.0f);
+  EXPECT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &cols, 0.5f, 0.0f).x, 0.0f);
 }
 
 // Placement in a homogeneous cube [−½, ½]³ of σt = 6 (grey), seen from (0, 0, −4) at 30°: along a
