@@ -28,12 +28,12 @@
  * estimates J̄_s = ∫_s J e^{−τ} dτ / ∫_s e^{−τ} dτ, and Σ_s (T_s − T_{s+1})·J̄_s is the column's own
  * in-scattering ∫ J e^{−τ} dτ exactly (for the grey σs/σt of a medium of one albedo). Point nodes
  * interpolated linearly in τ were biased where J falls steeply under the surface (convex in τ): the
- * back-lit Disney cloud read 1.4–4x too bright in its darkest sixths at 8 slices, 1.2–3x at 16.
+ * back-lit Disney cloud's darker half read 1.1–2.8x the path tracer's at 8 slices (bench/RESULTS.md).
  *
  * Lookup: a pixel's sample at grey optical depth τ (its own march's, ms_view_columns) reads its
- * four nearest columns, bilinear in image space; each column gives the slice that holds τ (the
- * first below τ_0, the last past its end), and columns without medium drop out (the weights of the
- * others renormalised). Reading by τ rather than by distance keeps a pixel's layers registered with
+ * four nearest columns, bilinear in image space; each column's slices are integrated over the
+ * sample's march step (ms_view_lookup; the last slice runs on past its end), and columns without
+ * medium drop out (the weights of the others renormalised). Reading by τ rather than by distance keeps a pixel's layers registered with
  * its neighbours' when the surface is at different depths in them (a bump, a silhouette): the slice
  * one mean free path under the surface is read one mean free path under the pixel's own surface.
  * Errors: the tile's blur (the in-scattering varies more slowly in the image than the single
@@ -219,7 +219,7 @@ static inline vec3 ms_view_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOB
     while (s + 1 < c->nz && col[(size_t)(s + 1) * slice_stride + MS_VIEW_TAU] <= tau) ++s;
     vec3 J = vec3_splat(0.0f);
     if (end > tau) {
-      float lo = tau, total = 0.0f; /* the step's part inside slice s starts at lo */
+      float lo = tau, total = 0.0f; /* the step's part inside slice s starts at lo; at most nz pieces */
       for (;; ++s) {
         NV_GLOBAL const float* v = col + (size_t)s * slice_stride;
         const float hi = s + 1 < c->nz ? nv_fmin(col[(size_t)(s + 1) * slice_stride + MS_VIEW_TAU], end) : end;
