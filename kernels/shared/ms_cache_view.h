@@ -69,6 +69,17 @@ static inline float ms_view_sigma_t(NV_CONSTANT const medium_params* m) {
   return (st.x + st.y + st.z) / 3.0f;
 }
 
+/* A march step's grey optical depth at sample t (the step's middle; march_iter), and where within
+ * the step, τ(t) linear over it, the depth gathered before it (acc) plus the step's own (d) reaches
+ * `level`: the placement's and the path starts' walk along a column. */
+static inline float ms_view_step_depth(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg, float sigma,
+                                       float t, float delta) {
+  return sigma * nv_fmax(grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t)), 0.0f) * delta;
+}
+static inline float ms_view_step_cross(float t, float delta, float acc, float d, float level) {
+  return t - 0.5f * delta + delta * nv_fmin(1.0f, nv_fmax(0.0f, (level - acc) / d));
+}
+
 /* Level i of a column whose transmittance ends at t_end ("Layout"). */
 static inline float ms_view_level(float t_end, int i, int nz) {
   return -nv_log(1.0f - (1.0f - t_end) * (float)i / (float)nz);
@@ -115,14 +126,13 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
   float acc = 0.0f, end = seg.t0, t;
   march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_PLACE_STEPS);
   while (i <= c->nz && march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
-    const float d = sigma * nv_fmax(grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg.o, seg.d, t)), 0.0f) * it.delta;
+    const float d = ms_view_step_depth(KERNEL_CONTEXT_ARG, &seg, sigma, t, it.delta);
     if (!(d > 0.0f)) continue;
     end = t + 0.5f * it.delta;
     for (; i <= c->nz; ++i) {
       const float level = ms_view_level(t_end, i, c->nz);
       if (acc + d < level) break;
-      ms_view_store_level(cache, slice_stride, i, c->nz, level,
-                          t - 0.5f * it.delta + it.delta * nv_fmin(1.0f, nv_fmax(0.0f, (level - acc) / d)));
+      ms_view_store_level(cache, slice_stride, i, c->nz, level, ms_view_step_cross(t, it.delta, acc, d, level));
     }
     acc += d;
   }
@@ -149,10 +159,10 @@ static inline vec3 ms_view_sample_point(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
   if (seg.t1 > seg.t0) {
     march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_SAMPLE_STEPS);
     while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
-      const float d = sigma * nv_fmax(grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg.o, seg.d, t)), 0.0f) * it.delta;
+      const float d = ms_view_step_depth(KERNEL_CONTEXT_ARG, &seg, sigma, t, it.delta);
       if (!(d > 0.0f)) continue;
       if (acc + d >= target) {
-        at = t - 0.5f * it.delta + it.delta * nv_fmin(1.0f, nv_fmax(0.0f, (target - acc) / d));
+        at = ms_view_step_cross(t, it.delta, acc, d, target);
         break;
       }
       acc += d;
