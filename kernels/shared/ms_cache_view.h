@@ -215,7 +215,8 @@ static inline float ms_view_one_minus_exp(float x) { return x * march_step_weigh
  * on to ∞). A point read at the step's middle was a quadrature of its own: 60 steps through the
  * back-lit Disney cloud cross several slices each near its surface (JND 8.7% against 8.0% at 120
  * steps). The weight is the grey τ's; a chromatic medium's channels fall at their own rates within
- * a step. dtau = 0 reads the slice holding tau. */
+ * a step. A step inside one slice (most of them) and dtau = 0 read the slice holding tau, with no
+ * exponential. */
 static inline vec3 ms_view_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
                                   NV_PRIVATE const ms_view_columns* cols, float tau, float dtau) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
@@ -227,8 +228,9 @@ static inline vec3 ms_view_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOB
     if (!(cols->w[k] > 0.0f) || col[MS_VIEW_TAU] < 0.0f) continue;
     int s = 0;
     while (s + 1 < c->nz && col[(size_t)(s + 1) * slice_stride + MS_VIEW_TAU] <= tau) ++s;
+    const float first_end = s + 1 < c->nz ? col[(size_t)(s + 1) * slice_stride + MS_VIEW_TAU] : end;
     vec3 J = vec3_splat(0.0f);
-    if (end > tau) {
+    if (first_end < end) { /* the step crosses slices (first_end > tau; else it reads the one it is in) */
       float lo = tau, total = 0.0f; /* the step's part inside slice s starts at lo; at most nz pieces */
       for (;; ++s) {
         NV_GLOBAL const float* v = col + (size_t)s * slice_stride;
