@@ -21,16 +21,16 @@ static inline vec3 ms_cache_to_camera(NV_CONSTANT const scene_params* s, vec3 x)
 
 /* The direction path k looks along, ω: uniform on the sphere (pdf 1/4π: the mean radiance is R and
  * −3·L·ω estimates b), or for MS_CACHE_CLOSURE_CAMERA the reverse of a propagation direction w
- * drawn from the phase function about w_c (the mean radiance is then the in-scattering towards the
+ * drawn from the phase function about w_c, the direction to the camera (the mean radiance is then the in-scattering towards the
  * camera; ms_cache.h, "Closure"). ω is then the direction a camera path arriving at x along −w_c
  * would scatter into, drawn as the path tracer draws it, with density *pdf. */
-static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int closure, vec3 x, float u1, float u2,
+static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int closure, vec3 w_c, float u1, float u2,
                                       NV_PRIVATE float* pdf) {
   switch (closure) {
     case MS_CACHE_CLOSURE_LINEAR:
     case MS_CACHE_CLOSURE_HG: *pdf = 0.25f * NV_INV_PI; return sample_uniform_sphere(u1, u2);
     case MS_CACHE_CLOSURE_CAMERA:
-      return vec3_scale(phase_sample(s->medium.phase, s->medium.g, ms_cache_to_camera(s, x), u1, u2, pdf), -1.0f);
+      return vec3_scale(phase_sample(s->medium.phase, s->medium.g, w_c, u1, u2, pdf), -1.0f);
     default: *pdf = 0.0f; return sample_uniform_sphere(u1, u2); /* unknown: reported at the kernel's entry */
   }
 }
@@ -51,9 +51,10 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtim
   if (view) x = ms_view_sample_point(KERNEL_CONTEXT_ARG, rp, node, v, rng_uniform(&rng)); /* in its slice */
   const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
   float pdf;
-  *omega = ms_cache_direction(s, closure, x, u1, u2, &pdf);
+  const vec3 w_c = ms_cache_to_camera(s, x);
+  *omega = ms_cache_direction(s, closure, w_c, u1, u2, &pdf);
   vec3 L = vec3_splat(0.0f);
-  if (direct) L = pathtrace_direct(KERNEL_CONTEXT_ARG, x, vec3_scale(ms_cache_to_camera(s, x), -1.0f), &rng);
+  if (direct) L = pathtrace_direct(KERNEL_CONTEXT_ARG, x, vec3_scale(w_c, -1.0f), &rng);
   L = vec3_add(L, pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, direct ? pdf : 0.0f, &rng));
   if (!vec3_is_finite(L)) {
     *status |= STATUS_NAN;
