@@ -83,8 +83,9 @@
  * and b/R (at MS_CACHE_RATIO), so that a lookup takes no logarithm or division per corner (the
  * ray marcher makes one lookup per sample); each build launch
  * adds `paths` paths per node (progressive: a viewer refines it over frames), path k of node n
- * drawing its random numbers from its own counter-based stream (seed, n, k), so the cache after K
- * paths is the same whatever the launches it was split into (ms_cache_build.h). */
+ * drawing its random numbers from its own counter-based stream (seed, n, k) and its leading
+ * coordinates from node n's scrambled Sobol pairs at index k, so the cache after K paths is the same
+ * whatever the launches it was split into (ms_cache_build.h). */
 #ifndef NARVAL_MS_CACHE_H
 #define NARVAL_MS_CACHE_H
 
