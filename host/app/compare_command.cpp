@@ -1,6 +1,7 @@
 // compare_command.cpp: `narval compare REF.exr TEST.exr` (DESIGN.md, Perceptual metric): mean,
 // 95th percentile and max of ΔE76 and ΔE2000 and the JND% (ΔE > 2.3) of each, as a table or as JSON;
-// optionally the ΔE76 heat map and the JND map as PNGs.
+// optionally the ΔE76 heat map and the JND map as PNGs, and the floor the reference's own noise puts
+// under the JND% (--reference-snapshot, render/reference_noise.h).
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include "app/commands.h"
 #include "image/image.h"
 #include "image/image_compare.h"
+#include "render/reference_noise.h"
 #include "scene/input_error.h"
 
 namespace fs = std::filesystem;
@@ -26,6 +28,7 @@ namespace {
 
 struct CompareArgs {
   std::string reference, test, tonemap, heatmap, jndMap;  // tonemap "": the EXRs' (below)
+  std::string snapshot;                                    // --reference-snapshot: "" for none
   std::optional<double> exposure;                          // double: the JSON echoes what was typed
   double heatmapMax = 10.0;
   bool json = false;
@@ -92,6 +95,8 @@ int runCompare(const CompareArgs& a) {
 
   const ImageRGB reference = readExr(a.reference);
   const ImageRGB test = readExr(a.test);
+  std::optional<ReferenceNoise> noise;
+  if (!a.snapshot.empty()) noise = estimateReferenceNoise(a.reference, reference, a.snapshot);
   // Flags win; what they leave open comes from the EXRs when both record the same transform.
   const RecordedDisplay recorded = recordedDisplay(a.reference, a.test);
   const bool anyFlag = a.exposure || !tmName.empty(), allFlags = a.exposure && !tmName.empty();
@@ -107,6 +112,8 @@ int runCompare(const CompareArgs& a) {
   display.exposureStops = float(exposure);
   display.toneMapping = toneMapping;
   const ImageComparison c = compareImages(reference, test, display, a.reference, a.test);
+  std::optional<ImageComparison> floor;  // a noise-free image against the reference, estimated
+  if (noise) floor = compareImages(reference, noise->perturbed, display, a.reference, a.snapshot);
 
   if (!a.heatmap.empty()) {
     writeDeltaEHeatmap(a.heatmap, c.dE76, c.width, c.height, float(a.heatmapMax));
@@ -116,7 +123,7 @@ int runCompare(const CompareArgs& a) {
   }
 
   if (a.json) {
-    const nlohmann::ordered_json j = {{"reference", a.reference},
+    nlohmann::ordered_json j = {{"reference", a.reference},
                                       {"test", a.test},
                                       {"width", c.width},
                                       {"height", c.height},
@@ -132,6 +139,14 @@ int runCompare(const CompareArgs& a) {
                                       {"max_dE2000", c.stats2000.max},
                                       {"jnd2000_pct", c.stats2000.jndPercent},
                                       {"rel_mse", c.relMse}};
+    if (floor)
+      j["reference_noise"] = {{"snapshot", a.snapshot},
+                              {"snapshot_spp", noise->snapshotSamples},
+                              {"reference_spp", noise->referenceSamples},
+                              {"mean_dE76", floor->stats76.mean},
+                              {"jnd76_pct", floor->stats76.jndPercent},
+                              {"mean_dE2000", floor->stats2000.mean},
+                              {"jnd2000_pct", floor->stats2000.jndPercent}};
     std::cout << j.dump(2) << "\n";
     return 0;
   }
@@ -144,6 +159,11 @@ int runCompare(const CompareArgs& a) {
   std::cout << header << tableRow("dE76", c.stats76) << tableRow("dE2000", c.stats2000)
             << "(p95: the value of rank ceil(0.95 n); JND%: pixels with dE > 2.3)\n"
             << "relMSE (linear, before the display transform) " << c.relMse << "\n";
+  if (floor)
+    std::cout << "reference noise (from " << a.snapshot << ", " << noise->snapshotSamples << " of its "
+              << noise->referenceSamples << " samples): a noise-free image would read about JND "
+              << fixed(floor->stats76.jndPercent, 2) << "% (dE76 mean " << fixed(floor->stats76.mean, 4) << "), "
+              << fixed(floor->stats2000.jndPercent, 2) << "% in dE2000\n";
   if (!a.heatmap.empty()) std::cout << "wrote " << a.heatmap << " (dE76, 0 to " << fixed(a.heatmapMax, 2) << ")\n";
   if (!a.jndMap.empty()) std::cout << "wrote " << a.jndMap << " (dE76 > 2.3 in red)\n";
   return 0;
@@ -167,6 +187,9 @@ Command addCompareCommand(CLI::App& app) {
   sub->add_option("--heatmap-max", a->heatmapMax, "ΔE at the top of the heat map's scale (default 10)");
   sub->add_option("--jnd-map", a->jndMap,
                   "Write the JND map (pixels with ΔE76 > 2.3 in red over the test image) as PNG");
+  sub->add_option("--reference-snapshot", a->snapshot,
+                  "An earlier snapshot of REF's path-traced render (its first samples, before --resume "
+                  "continued it): also report the JND% that REF's own noise alone would give");
   sub->add_flag("--json", a->json, "Print one JSON object instead of the table");
   return {sub, [a]() { return runCompare(*a); }};
 }

@@ -218,5 +218,74 @@ TEST_F(CompareCli, BadOptions) {
   EXPECT_EQ(run("compare a.exr a.exr --tonemap ACES").code, 0);
 }
 
+// --reference-snapshot (render/reference_noise.h): a reference of 8192 samples, grey 0.125, and its
+// snapshot after the first 2048, where 12 pixels read 0.125 + √3·0.091. The reference's own error is
+// then estimated as (1/√3)·(S − R) (k = √(2048/6144)), which puts those 12 pixels at 0.216: ΔE76
+// 116·(∛0.216 − ∛0.125) = 116·(0.6 − 0.5) = 11.6 each (L* of a grey Y > 0.008856 is 116·∛Y − 16),
+// so a noise-free image would read mean ΔE76 12·11.6/80 = 1.74 and JND 15% against it. The test
+// image itself is the reference, at ΔE 0.
+std::vector<ExrAttribute> pathtraceAttributes(int begin, int end, const std::string& key, double seed) {
+  return {{"narval:algorithm", std::string("pathtrace")},
+          {"narval:spp", end - begin},
+          {"narval:sample_begin", begin},
+          {"narval:sample_end", end},
+          {"narval:status", 0},
+          {"narval:seed", seed},
+          {"narval:render_key", key}};
+}
+
+TEST_F(CompareCli, ReferenceSnapshotEstimatesTheReferencesOwnNoise) {
+  const ImageRGB ref = uniform(10, 8, 0.125f);
+  ImageRGB snap = ref;
+  for (int i = 0; i < 12; ++i) {
+    float* p = snap.pixel(i % 10, i / 10);
+    p[0] = p[1] = p[2] = float(0.125 + std::sqrt(3.0) * (0.216 - 0.125));
+  }
+  writeExr((dir_ / "ref.exr").string(), ref, pathtraceAttributes(0, 8192, "k1", 1.0));
+  writeExr((dir_ / "snap.exr").string(), snap, pathtraceAttributes(0, 2048, "k1", 1.0));
+  const RunResult r = run("compare ref.exr ref.exr --tonemap none --exposure 0 --reference-snapshot snap.exr --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["jnd76_pct"].get<double>(), 0.0);
+  const nlohmann::json& n = j["reference_noise"];
+  EXPECT_EQ(n["snapshot"], "snap.exr");
+  EXPECT_EQ(n["snapshot_spp"], 2048);
+  EXPECT_EQ(n["reference_spp"], 8192);
+  EXPECT_NEAR(n["mean_dE76"].get<double>(), 1.74, 1e-3);
+  EXPECT_DOUBLE_EQ(n["jnd76_pct"].get<double>(), 15.0);
+  const RunResult t = run("compare ref.exr ref.exr --tonemap none --exposure 0 --reference-snapshot snap.exr");
+  ASSERT_EQ(t.code, 0) << t.err;
+  EXPECT_NE(t.out.find("reference noise (from snap.exr, 2048 of its 8192 samples): a noise-free image would read "
+                       "about JND 15.00% (dE76 mean 1.7400)"),
+            std::string::npos)
+      << t.out;
+}
+
+// A snapshot that is not an earlier part of the reference's render: one line naming it and the
+// attribute, exit 2.
+TEST_F(CompareCli, ReferenceSnapshotMustBeAnEarlierPartOfTheSameRender) {
+  const ImageRGB im = uniform(10, 8, 0.125f);
+  writeExr((dir_ / "ref.exr").string(), im, pathtraceAttributes(0, 2048, "k1", 1.0));
+  writeExr((dir_ / "other.exr").string(), im, pathtraceAttributes(0, 1024, "k2", 1.0));
+  writeExr((dir_ / "seed.exr").string(), im, pathtraceAttributes(0, 1024, "k1", 2.0));
+  writeExr((dir_ / "more.exr").string(), im, pathtraceAttributes(0, 8192, "k1", 1.0));
+  writeImage("plain.exr", im);
+  const std::pair<const char*, const char*> cases[] = {
+      {"other.exr", "narval: other.exr: narval:render_key: rendered from other settings than ref.exr\n"},
+      {"more.exr",
+       "narval: more.exr: narval:sample_end: samples [0, 8192) are not a smaller part of the reference's [0, 2048)\n"},
+      {"plain.exr", "narval: plain.exr: narval:algorithm: missing: not a narval path-traced render with its samples\n"}};
+  for (const auto& [file, message] : cases) {
+    const RunResult r = run(std::string("compare ref.exr ref.exr --reference-snapshot ") + file);
+    EXPECT_EQ(r.code, 2) << file;
+    EXPECT_EQ(r.err, message);
+    EXPECT_EQ(r.out, "");
+  }
+  const RunResult seed = run("compare ref.exr ref.exr --reference-snapshot seed.exr");
+  EXPECT_EQ(seed.code, 2);
+  EXPECT_EQ(std::count(seed.err.begin(), seed.err.end(), '\n'), 1) << seed.err;
+  EXPECT_EQ(seed.err.rfind("narval: seed.exr: narval:seed: seed 2", 0), 0u) << seed.err;
+}
+
 }  // namespace
 }  // namespace narval
