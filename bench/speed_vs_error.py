@@ -31,7 +31,9 @@ renderer.raymarch.msCache.resolution.
 For each scene (default scenes/cloud.json, scenes/smoke.json, scenes/disney_cloud.json (the Disney
 cloud lit from behind, the dissertation's Listing 4.1) and scenes/disney_cloud_front.json (lit from
 the front); a scene whose volume file is absent is skipped, saying why):
-  1. a converged path-traced reference: `narval render SCENE --spp N --resolution R --seed 1`,
+  1. a converged path-traced reference: `narval render SCENE --spp N --resolution R --seed 1`
+     (N/4 samples first, kept as snapshot.exr, then continued by --resume: `compare
+     --reference-snapshot` then estimates the JND% its own noise alone gives, reported with it),
      cached under a hash of the scene file, its volume files (path, size, mtime), resolution, spp,
      bounces, the narval version and the reference format, so reruns skip it (the path tracer's pixels
      are pinned by its bitwise golden tests; --refresh-reference renders again after changing it);
@@ -89,7 +91,7 @@ REPO = Path(__file__).resolve().parent.parent
 DEFAULT_SCENES = ["scenes/cloud.json", "scenes/smoke.json", "scenes/disney_cloud.json",
                   "scenes/disney_cloud_front.json"]
 REFERENCE_SEED = 1
-REFERENCE_FORMAT = 2  # raise when the path tracer's output changes on purpose: cached references go stale
+REFERENCE_FORMAT = 3  # raise when the path tracer's output changes on purpose: cached references go stale
 TEST_SEED = 2
 DEFAULT_BUDGETS_MS = [16, 100]
 
@@ -469,13 +471,39 @@ def reference_key(scene, settings, bounces, version):
 
 
 def render_reference(settings, scene, bounces, folder):
-    """Renders the reference into folder/reference.exr (+ .png, stats.json); returns its stats."""
+    """Renders the reference into folder/reference.exr (+ .png, stats.json), a quarter of its samples
+    first, kept as folder/snapshot.exr, then the rest by --resume (the same pixels as one render:
+    its samples are counter-based); returns its stats, seconds summed over both runs. The snapshot
+    lets `compare --reference-snapshot` estimate the reference's own noise floor."""
     folder.mkdir(parents=True, exist_ok=True)
-    run_narval(settings, ["render", scene["path"], "-o", folder / "reference.exr", "--algorithm", "pathtrace",
-                          "--spp", settings.reference_spp, "--bounces", bounces, "--resolution", settings.resolution,
-                          "--seed", REFERENCE_SEED, "--stats-json", folder / "stats.json"] + device_options(settings))
+    common = ["--algorithm", "pathtrace", "--bounces", bounces, "--resolution", settings.resolution,
+              "--seed", REFERENCE_SEED] + device_options(settings)
+    snapshot_spp = max(1, settings.reference_spp // 4)
+    run_narval(settings, ["render", scene["path"], "-o", folder / "reference.exr", "--spp", snapshot_spp,
+                          "--stats-json", folder / "stats.json"] + common)
     with open(folder / "stats.json") as f:
-        return json.load(f)
+        seconds = json.load(f)["seconds"]
+    if settings.reference_spp > snapshot_spp:
+        shutil.copyfile(folder / "reference.exr", folder / "snapshot.exr")
+        run_narval(settings, ["render", scene["path"], "-o", folder / "reference.exr", "--spp",
+                              settings.reference_spp, "--resume", "--stats-json", folder / "stats.json"] + common)
+    with open(folder / "stats.json") as f:
+        stats = json.load(f)
+    if settings.reference_spp > snapshot_spp:
+        stats["seconds"] += seconds
+        with open(folder / "stats.json", "w") as f:
+            json.dump(stats, f)
+    return stats
+
+
+def reference_noise(settings, scene, reference_exr, snapshot_exr):
+    """What the reference's own noise alone reads (compare --reference-snapshot): the JND% and mean
+    ΔE76 a noise-free image would have against it; None when it has no snapshot."""
+    if not Path(snapshot_exr).is_file():
+        return None
+    output = run_narval(settings, ["compare", reference_exr, reference_exr, "--reference-snapshot", snapshot_exr,
+                                   "--json"] + scene["display"]["options"])
+    return json.loads(output)["reference_noise"]
 
 
 def ensure_reference(settings, scene, version, scene_out):
@@ -504,13 +532,18 @@ def ensure_reference(settings, scene, version, scene_out):
             cached = scene_out / "reference_render"
     with open(cached / "stats.json") as f:
         stats = json.load(f)
-    for name in ("reference.exr", "reference.png"):
-        shutil.copyfile(cached / name, scene_out / name)
+    for name in ("reference.exr", "reference.png", "snapshot.exr"):
+        if (cached / name).is_file():
+            shutil.copyfile(cached / name, scene_out / name)
     if not from_cache:
         print("  reference: %.1f s" % stats["seconds"], flush=True)
+    noise = reference_noise(settings, scene, scene_out / "reference.exr", scene_out / "snapshot.exr")
+    if noise:
+        print("  reference noise alone: JND %.2f%% (from its first %d samples)" % (noise["jnd76_pct"],
+                                                                                 noise["snapshot_spp"]), flush=True)
     return {"exr": scene_out / "reference.exr", "png": "reference.png", "spp": settings.reference_spp,
             "bounces": bounces, "seed": REFERENCE_SEED, "seconds": stats["seconds"], "device": stats["device"],
-            "cached": from_cache, "key": key, "cache_folder": str(cached)}
+            "cached": from_cache, "key": key, "cache_folder": str(cached), "noise": noise}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -993,10 +1026,15 @@ def settings_text(method):
 
 def reference_sentence(scene, reference):
     how = "from the cache" if reference["cached"] else "rendered in %.1f s" % reference["seconds"]
+    noise = reference.get("noise")
+    floor = (" Its own noise alone reads JND %.2f%% (mean ΔE76 %.3f): what a noise-free image would read "
+             "against it, estimated from its first %d samples (`compare --reference-snapshot`); a JND%% near "
+             "this is at the reference's floor." % (noise["jnd76_pct"], noise["mean_dE76"], noise["snapshot_spp"])
+             if noise else "")
     return ("Reference: pathtrace, %d spp, %d bounces, seed %d, on %s (%s). ΔE under the scene's display: "
-            "tone mapping %s, exposure %g." % (reference["spp"], reference["bounces"], reference["seed"],
-                                               reference["device"], how, scene["display"]["tonemap"],
-                                               scene["display"]["exposure"]))
+            "tone mapping %s, exposure %g.%s" % (reference["spp"], reference["bounces"], reference["seed"],
+                                                 reference["device"], how, scene["display"]["tonemap"],
+                                                 scene["display"]["exposure"], floor))
 
 
 def base_sentence(bases):
