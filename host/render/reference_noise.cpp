@@ -25,16 +25,19 @@ ReferenceNoise estimateReferenceNoise(const std::string& referencePath, const Im
                          std::to_string(ra.end()) + ")");
   const ImageRGB snapshot = readExr(snapshotPath);
   if (snapshot.width != reference.width || snapshot.height != reference.height)
-    throw inputError(snapshotPath, "", "size " + std::to_string(snapshot.width) + "x" + std::to_string(snapshot.height) +
-                                           ", the reference's " + std::to_string(reference.width) + "x" +
-                                           std::to_string(reference.height));
+    throw inputError(snapshotPath, "",
+                     "size " + std::to_string(snapshot.width) + "x" + std::to_string(snapshot.height) +
+                         ", the reference's " + std::to_string(reference.width) + "x" +
+                         std::to_string(reference.height));
   ReferenceNoise n;
   n.snapshotSamples = sa.samples;
   n.referenceSamples = ra.samples;
   n.scale = std::sqrt(double(sa.samples) / double(ra.samples - sa.samples));
   n.perturbed = reference;
-  for (size_t i = 0; i < n.perturbed.rgb.size(); ++i)
-    n.perturbed.rgb[i] = float(double(reference.rgb[i]) + n.scale * (double(snapshot.rgb[i]) - double(reference.rgb[i])));
+  for (size_t i = 0; i < n.perturbed.rgb.size(); ++i) {
+    const double r = reference.rgb[i], snap = snapshot.rgb[i];
+    n.perturbed.rgb[i] = float(r + n.scale * (snap - r));
+  }
   return n;
 }
 

@@ -24,9 +24,10 @@
  * 400 paths) two cache seeds' relative MSE falls from 1.13e-3 to 1.00e-3, and with the direct
  * light alone (bounces 1) from 4.3e-4 to 3.3e-4: there the paths' further bounces hold most of
  * the noise, and they draw at random (delta tracking takes as many numbers as it needs). Each
- * node scrambles with its own seeds (drawn from its own stream at sample index
- * MS_CACHE_LEADING_STREAM, which no path reaches), so nodes' errors stay independent and the cache after K paths is the same whatever
- * launches it was split into. The rest of a path draws from its counter-based stream (rng.h). */
+ * node scrambles with its own seeds (drawn once per launch from its own stream at sample index
+ * MS_CACHE_LEADING_STREAM, which no path reaches), so nodes' errors stay independent and the cache
+ * after K paths is the same whatever launches it was split into. The rest of a path draws from its
+ * counter-based stream (rng.h). */
 #define MS_CACHE_LEADING_STREAM 0xFFFFFFFFu
 #define MS_CACHE_LEADING_KEYS 9 /* three pairs: the index's seed, then each axis's */
 static inline void ms_cache_leading_keys(uint seed, int node, NV_PRIVATE uint* keys) {

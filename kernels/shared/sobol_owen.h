@@ -1,9 +1,9 @@
 /* sobol_owen.h: a progressive two-dimensional low-discrepancy sequence, Sobol's first two dimensions
  * with hash-based Owen scrambling (Burley 2020, "Practical Hash-based Owen Scrambling", JCGT 9(4)).
- * Used where a few leading dimensions of many paths at one point carry most of the variance (the
- * multiple-scattering cache's paths: where in its slice a path starts, the direction it leaves in,
- * the light point its next-event estimate aims at; ms_cache_build.h); the rest of a path draws from
- * its counter-based stream (rng.h) as before.
+ * Used for the few leading dimensions of many paths at one point on which their result depends
+ * smoothly (the multiple-scattering cache's paths: where in its slice a path starts, the direction
+ * it leaves in, the light point its next-event estimate aims at; ms_cache_build.h); the rest of a
+ * path draws from its counter-based stream (rng.h) as before.
  *
  * Sobol's first two dimensions form a (0,2)-sequence in base 2: every aligned block of 2^m indices,
  * [c·2^m, (c+1)·2^m), is a (0,m,2)-net (each of the 2^m elementary intervals [a/2^j, (a+1)/2^j) ×
