@@ -2,7 +2,7 @@
 # bench/device/pack.sh: packs what a run on the lent GPU machine needs into .devrun/ (ignored via
 # .git/info/exclude; name it in the device tool's `carry`). That machine is not Debian and has no
 # narval dependencies: this carries the built binaries, their shared libraries (xz, ~7 MB), an ICD
-# file naming NVIDIA's libnvidia-opencl.so.1 and the small Disney cloud. There, in the repository
+# file naming NVIDIA's libnvidia-opencl.so.1, the small Disney cloud and the OpenVDB smoke. There, in the repository
 # root: `source bench/device/setup.sh`, then run build/narval, the test binaries or
 # bench/device/gpu_bench.sh. See bench/RESULTS.md ("NVIDIA H100") for what worked.
 set -euo pipefail
@@ -20,5 +20,5 @@ strip --strip-unneeded .devrun/lib/* 2>/dev/null || true
 tar -C .devrun -cJf .devrun/lib.tar.xz lib && rm -rf .devrun/lib
 echo libnvidia-opencl.so.1 >.devrun/icd/nvidia.icd
 data=${NARVAL_DATA_DIR:-../shared/data/volumes}
-[ -f "$data/wdas_cloud_sixteenth.vdb" ] && cp "$data/wdas_cloud_sixteenth.vdb" .devrun/data/
+for g in wdas_cloud_sixteenth.vdb openvdb_smoke1_v222.vdb; do [ -f "$data/$g" ] && cp "$data/$g" .devrun/data/; done
 du -sh .devrun
