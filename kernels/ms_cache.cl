@@ -4,6 +4,7 @@
  * with one bounce fewer (ms_cache.h, "Bounces"). */
 #include "shared/scene_kinds.h"
 #include "shared/ms_cache_build.h"
+#include "shared/ms_cache_filter.h"
 
 __kernel void ms_cache_build(KERNEL_SCENE_ARGS,
                              __constant realtime_params* params, uint first, uint count, __global float* cache,
@@ -28,4 +29,16 @@ __kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, __constant realtime_params*
   ctx.status = scene_kinds_status(scene, lights) | realtime_kinds_status(params); /* STATUS_UNKNOWN_KIND */
   ms_view_place_column(KERNEL_ENTRY_ARG(ctx), params, column, cache + (size_t)column * MS_CACHE_STRIDE);
   if (ctx.status) atomic_or(status_word, ctx.status);
+}
+
+/* The view layout's filter (ms_cache_filter.h): one work-item per column, after every
+ * ms_cache_build launch; `filtered` (the cache's layout, a copy of each node with its R filtered)
+ * is what the march reads. */
+__kernel void ms_cache_filter_view(__constant realtime_params* params, __global const float* cache,
+                                   __global float* filtered) {
+  const int column = get_global_id(0);
+  __constant node_grid_params* c = &params->ms_cache;
+  if (column >= c->nx * c->ny) return;
+  ms_view_filter_column(c, cache, column, params->ms_cache_filter, params->ms_cache_filter_tolerance,
+                        filtered + (size_t)column * MS_CACHE_STRIDE);
 }

@@ -90,6 +90,8 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"ms_cache_paths", s.msCachePaths},
           {"ms_cache_builds", s.msCacheBuilds},
           {"ms_cache_ms", s.msCacheMs},
+          {"ms_cache_filter", s.msCacheFilter},
+          {"ms_cache_filter_tolerance", s.msCacheFilterTolerance},
           {"status",
            {{"nan", (s.status & STATUS_NAN) != 0},
             {"negative_pdf", (s.status & STATUS_NEGATIVE_PDF) != 0},
@@ -283,11 +285,15 @@ int runRender(const RenderArgs& a) {
     report << "light cache: " << s.lightCacheCells[0] << "x" << s.lightCacheCells[1] << "x" << s.lightCacheCells[2]
               << " cells, " << s.lightCacheBuilds << (s.lightCacheBuilds == 1 ? " light" : " lights") << " built in "
               << s.lightCacheMs << " ms (not in the frame times)\n";
-  if (s.msCacheBuilds > 0)
+  if (s.msCacheBuilds > 0) {
     report << "multiple-scattering cache: " << s.msCacheCells[0] << "x" << s.msCacheCells[1] << "x"
-              << s.msCacheCells[2] << (s.msCacheView ? " columns x rows x slices, " : " cells, ") << s.msCachePaths
-              << " paths per node in " << s.msCacheMs
-              << " ms (not in the frame times)\n";
+           << s.msCacheCells[2] << (s.msCacheView ? " columns x rows x slices, " : " cells, ") << s.msCachePaths
+           << " paths per node";
+    if (s.msCacheFilter > 0)
+      report << ", filtered (sigma " << s.msCacheFilter << " columns, tolerance " << s.msCacheFilterTolerance
+             << " standard errors)";
+    report << " in " << s.msCacheMs << " ms (not in the frame times)\n";
+  }
   report << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
             << s.algorithm << ", ";
   if (realtime)

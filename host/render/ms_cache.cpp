@@ -24,14 +24,17 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions() +
                     (towardsCamera ? "camera" : "uniform") + std::to_string(params.ms_cache_layout) + "/" +
                     std::to_string(params.ms_cache_tile) + (params.ms_cache_direct ? "/direct" : "");
+  const bool view = params.ms_cache_layout == MS_CACHE_LAYOUT_VIEW;
+  filterOn_ = view && params.ms_cache_filter > 0;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
-    const bool view = params.ms_cache_layout == MS_CACHE_LAYOUT_VIEW;
-    const AllocationSite site{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
+    site_ = AllocationSite{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
                                   "x" + std::to_string(c.nz) + " nodes"};
-    buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site);
+    buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+    filtered_ = cl::Buffer();  // allocated by the filter when it is on
+    filteredKey_.clear();
     rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
     program_ = buildProgram(rt, "ms_cache.cl", dev.buildOptions());
     kernel_ = NamedKernel(program_, "ms_cache_build");
@@ -53,7 +56,13 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
                                   deviceSceneBytes(dev.scene) + bytes_);
     }
   }
-  if (paths_ >= targetPaths) return;
+  if (paths_ < targetPaths) addPaths(rt, dev, params, targetPaths, pathsPerLaunch);
+  if (filterOn_) filter(rt, params);
+}
+
+void DeviceMsCache::addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params,
+                             int targetPaths, int pathsPerLaunch) {
+  const size_t nodes = nodeGridCount(params.ms_cache);
   paramBuf_ = constantBuffer(rt, params);
   dev.bind(kernel_);
   kernel_.set("scene", sceneBuf_);  // the scene the paths see (one bounce fewer)
@@ -69,6 +78,21 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
     paths_ += count;
   }
   status_ |= readStatusWord(rt, statusBuf_);
+}
+
+void DeviceMsCache::filter(ClRuntime& rt, const realtime_params& params) {
+  if (!filtered_()) filtered_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+  const std::string key =
+      std::to_string(paths_) + "/" + rawBytes(params.ms_cache_filter) + rawBytes(params.ms_cache_filter_tolerance);
+  if (key == filteredKey_) return;
+  NamedKernel filter(program_, "ms_cache_filter_view");
+  const cl::Buffer paramBuf = constantBuffer(rt, params);  // alive until the launch has run
+  filter.set("params", paramBuf);
+  filter.set("cache", buffer_);
+  filter.set("filtered", filtered_);
+  buildMs_ += launchOverNodes(rt, filter.get(), size_t(params.ms_cache.nx) * size_t(params.ms_cache.ny),
+                              "the multiple-scattering cache", 2 * bytes_);
+  filteredKey_ = key;
 }
 
 }  // namespace narval

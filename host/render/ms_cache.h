@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cl/cl_runtime.h"
+#include "render/device_allocation.h"
 #include "render/device_scene.h"
 #include "shared/structs.h"
 
@@ -21,7 +22,10 @@ class DeviceMsCache {
   // allocation (naming `sceneFile` and renderer.raymarch.msCache.resolution).
   void refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params, int targetPaths,
               int pathsPerLaunch, const std::string& sceneFile);
-  const cl::Buffer& buffer() const { return buffer_; }
+  // What the march reads: the running means, or with the view layout's filter on
+  // (params.ms_cache_filter > 0; kernels/shared/ms_cache_filter.h) their filtered copy.
+  const cl::Buffer& buffer() const { return filterOn_ ? filtered_ : buffer_; }
+  const cl::Buffer& means() const { return buffer_; }  // the running means, unfiltered
   int paths() const { return paths_; }             // paths per node so far
   int rebuilds() const { return rebuilds_; }       // times it started over (1 for one scene)
   double buildMs() const { return buildMs_; }      // launch time by profiling events, all launches
@@ -29,10 +33,17 @@ class DeviceMsCache {
   uint32_t status() const { return status_; }
 
  private:
+  void addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params, int targetPaths,
+                int pathsPerLaunch);
+  void filter(ClRuntime& rt, const realtime_params& params);  // the filtered copy, when the paths or settings changed
+
   std::string key_;
+  AllocationSite site_;  // what an allocation failure names (the scene file and key)
   cl::Program program_;
   NamedKernel kernel_;
-  cl::Buffer buffer_, sceneBuf_, paramBuf_, statusBuf_;
+  cl::Buffer buffer_, filtered_, sceneBuf_, paramBuf_, statusBuf_;
+  bool filterOn_ = false;
+  std::string filteredKey_;  // the paths and filter settings the filtered copy was made from
   int paths_ = 0, rebuilds_ = 0;
   double buildMs_ = 0;
   size_t bytes_ = 0;

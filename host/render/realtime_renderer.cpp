@@ -76,6 +76,10 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   }
   if (mc.layout == MsCacheLayout::View) p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA;  // its paths aim at the camera
   p.ms_cache_direct = msCache && mc.direct;
+  if (mc.layout == MsCacheLayout::View) {  // the guided filter over the view nodes (ms_cache_filter.h)
+    p.ms_cache_filter = mc.filter;
+    p.ms_cache_filter_tolerance = mc.filterTolerance;
+  }
   if (p.ms_cache_direct) p.light_cache = node_grid_params{};  // no light loop: no shadow rays to cache
   switch (r.raymarch.msCache.interpolation) {
     case MsCacheInterpolation::Geometric: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_GEOMETRIC; break;
@@ -205,6 +209,8 @@ RenderResult RealtimeRenderer::result() {
     st.msCacheCells[0] = params_.ms_cache.nx;
     st.msCacheCells[1] = params_.ms_cache.ny;
     st.msCacheCells[2] = params_.ms_cache.nz;
+    st.msCacheFilter = params_.ms_cache_filter;
+    st.msCacheFilterTolerance = params_.ms_cache_filter > 0 ? params_.ms_cache_filter_tolerance : 0;
   } else {
     nodeGridCells(params_.ms_cache, st.msCacheCells);
   }

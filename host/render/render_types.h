@@ -101,6 +101,8 @@ struct RenderStats {
   bool msCacheView = false;
   int msCachePaths = 0, msCacheBuilds = 0;
   double msCacheMs = 0;
+  // The view layout's filter (kernels/shared/ms_cache_filter.h): σ_s in columns (0: off) and k.
+  float msCacheFilter = 0, msCacheFilterTolerance = 0;
 };
 
 struct RenderResult {

@@ -120,6 +120,10 @@ struct MsCacheSettings {
   // The lights' unscattered light: added by the march (false) or held by the cache with the rest
   // (kernels/shared/ms_cache.h, "Direct"; closure "camera" or layout "view" only).
   bool direct = false;
+  // view: the filter over the nodes (kernels/shared/ms_cache_filter.h): σ_s in columns (0: off)
+  // and k, the standard errors by which a neighbour may differ before it loses weight.
+  float filter = 0;
+  float filterTolerance = 1;
   int paths = 256;          // paths per node
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
 };

@@ -91,6 +91,10 @@
 // |                         | lights' unscattered light too   |     |             | view; no light loop        |
 // |   raymarch.msCache.tile | integer: pixels per column side |     | 4           | [1, 256]; view             |
 // |   raymarch.msCache.slices | integer: nodes per column     |     | 8           | [2, 64]; view              |
+// |   raymarch.msCache.filter | number: the nodes' filter's   |     | 0 (off)     | [0, 8]; view               |
+// |                         | σ_s in columns (ms_cache_filter.h)|   |             |                            |
+// |   raymarch.msCache.filterTolerance | number: its k, in     |     | 1           | > 0; view                  |
+// |                         | standard errors                 |     |             |                            |
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
 // |   lobe.variant          | eq7, corrected (lobe.h)         |     | eq7         |                            |
 // |   lobe.depthFactor      | number (eq7)                    |     | 20          | >= 0                       |
@@ -474,8 +478,8 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
           mc.find("closure"))
         ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
       const bool view = s.raymarch.msCache.layout == MsCacheLayout::View;
-      for (const char* key : {"resolution", "interpolation", "tile", "slices"})
-        if (mc.find(key) && view != (std::string(key) == "tile" || std::string(key) == "slices"))
+      for (const std::string key : {"resolution", "interpolation", "tile", "slices", "filter", "filterTolerance"})
+        if (mc.find(key) && view != (key == "tile" || key == "slices" || key == "filter" || key == "filterTolerance"))
           ctx.warn(mc.keyOf(key), std::string("applies to layout \"") + (view ? "grid" : "view") + "\"; \"" +
                                       (view ? "view" : "grid") + "\" ignores it");
       s.raymarch.msCache.resolution = readInt(mc, "resolution", s.raymarch.msCache.resolution, 1, 256);
@@ -485,6 +489,12 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
         ctx.fail(mc.keyOf("direct"), "needs closure \"camera\" or layout \"view\" (a node must hold the light "
                                      "scattered towards the camera)");
       s.raymarch.msCache.slices = readInt(mc, "slices", s.raymarch.msCache.slices, 2, 64);
+      s.raymarch.msCache.filter = readNonNegative(mc, "filter", s.raymarch.msCache.filter);
+      if (s.raymarch.msCache.filter > 8)
+        ctx.fail(mc.keyOf("filter"), "must be at most 8 (columns), got " + formatNumber(s.raymarch.msCache.filter));
+      s.raymarch.msCache.filterTolerance = mc.getFloat("filterTolerance", s.raymarch.msCache.filterTolerance);
+      if (!(s.raymarch.msCache.filterTolerance > 0))
+        ctx.fail(mc.keyOf("filterTolerance"), "must be positive, got " + formatNumber(s.raymarch.msCache.filterTolerance));
       s.raymarch.msCache.paths = readInt(mc, "paths", s.raymarch.msCache.paths, 1, 1 << 20);
       s.raymarch.msCache.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.raymarch.msCache.pathsPerLaunch, 1, 1 << 20);
       mc.reportUnknown();

@@ -78,7 +78,8 @@
  * sampling alone, 6.1% with the next-event estimate, for 35% more build time.
  *
  * Storage: MS_CACHE_STRIDE floats per node: the running means of the paths so far, R (rgb) then
- * their count, then b for red, green and blue (xyz each, then an unused float); then what the
+ * their count, then b for red, green and blue (xyz each, then a free float; the one after red's
+ * holds the mean of the grey L², MS_CACHE_SQUARE, for the view filter's noise); then what the
  * lookup reads, derived from them by the build after each launch: ln R (rgb, at MS_CACHE_LOG_R)
  * and b/R (at MS_CACHE_RATIO), so that a lookup takes no logarithm or division per corner (the
  * ray marcher makes one lookup per sample); each build launch
@@ -92,6 +93,7 @@
 #include "shared/node_grid.h"
 
 #define MS_CACHE_STRIDE 32
+#define MS_CACHE_SQUARE 11 /* the running mean of ((L_r + L_g + L_b)/3)² (ms_cache_filter.h) */
 #define MS_CACHE_LOG_R 16 /* ln R per channel (−∞ where R = 0), written by the build */
 #define MS_CACHE_RATIO 20 /* b/R per channel (xyz each; 0 where R = 0), written by the build */
 /* Interpolation: log(R + floor), floor this fraction of the cell's largest R (a node at 0 then

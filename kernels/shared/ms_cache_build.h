@@ -132,6 +132,8 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
     const float n = (float)(k + 1u);
     const float Lc[3] = {L.x, L.y, L.z};
     const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */
+    const float grey = vec3_average(L);
+    v[MS_CACHE_SQUARE] += (grey * grey - v[MS_CACHE_SQUARE]) / n;
     for (int ch = 0; ch < 3; ++ch) {
       v[ch] += (Lc[ch] - v[ch]) / n;
       for (int a = 0; a < 3; ++a) v[4 + 4 * ch + a] += (Lc[ch] * w[a] - v[4 + 4 * ch + a]) / n;

@@ -172,8 +172,8 @@ typedef struct realtime_params {
   int ms_cache_tile;        /* MS_CACHE_LAYOUT_VIEW: pixels per column side (ms_cache.nx, ny columns) */
   int shadow_weighting;     /* raymarch: SHADOW_WEIGHTING_AREA or _PHASE (march_light_column) */
   int ms_cache_direct;      /* raymarch: 1: the cache holds the lights' unscattered light too (ms_cache.h, "Direct") */
-  int pad0;
-  int pad1;
+  float ms_cache_filter;    /* MS_CACHE_LAYOUT_VIEW: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
+  float ms_cache_filter_tolerance; /* the filter's k: standard errors a neighbour may differ by (ms_cache_filter.h) */
   int pad2;
 } realtime_params;
 

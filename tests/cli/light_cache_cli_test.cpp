@@ -96,6 +96,33 @@ TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
       << r.out;
 }
 
+// The view layout's filter is reported with its settings (the text line and the stats); given
+// with the grid layout, its keys are named in one warning each and the stats say it is off.
+TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
+  const std::string cache = "--set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.paths=4 "
+                            "--set renderer.raymarch.msCache.filter=1.5 --set renderer.raymarch.msCache.filterTolerance=2 ";
+  RunResult r = run("render s.json -o v.exr --stats-json v.json " + cache + "--set renderer.raymarch.msCache.layout=\\\"view\\\"");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  nlohmann::json s = stats("v.json");
+  EXPECT_EQ(s["ms_cache_filter"], 1.5);
+  EXPECT_EQ(s["ms_cache_filter_tolerance"], 2.0);
+  EXPECT_EQ(s["nan_pixels"], 0);
+  EXPECT_NE(r.out.find("\nmultiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
+                       "1.5 columns, tolerance 2 standard errors) in "),
+            std::string::npos)
+      << r.out;
+  r = run("render s.json -o g.exr --stats-json g.json " + cache);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err,
+            "narval: warning: s.json: renderer.raymarch.msCache.filter: applies to layout \"view\"; \"grid\" ignores it\n"
+            "narval: warning: s.json: renderer.raymarch.msCache.filterTolerance: applies to layout \"view\"; \"grid\" "
+            "ignores it\n");
+  s = stats("g.json");
+  EXPECT_EQ(s["ms_cache_filter"], 0.0);
+  EXPECT_EQ(s["ms_cache_filter_tolerance"], 0.0);
+}
+
 // Moving the point light is a new cache: the image changes where its light reaches the cloud.
 TEST_F(LightCacheCli, MovingALightChangesTheImage) {
   ASSERT_EQ(run("render s.json -o a.exr --stats-json a.json").code, 0);
@@ -165,6 +192,14 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
       {"renderer.raymarch.msCache.tile=0", "narval: s.json: renderer.raymarch.msCache.tile: must be at least 1, got 0\n"},
       {"renderer.raymarch.msCache.slices=1",
        "narval: s.json: renderer.raymarch.msCache.slices: must be at least 2, got 1\n"},
+      {"renderer.raymarch.msCache.filter=-1",
+       "narval: s.json: renderer.raymarch.msCache.filter: must be non-negative, got -1\n"},
+      {"renderer.raymarch.msCache.filter=9",
+       "narval: s.json: renderer.raymarch.msCache.filter: must be at most 8 (columns), got 9\n"},
+      {"renderer.raymarch.msCache.filterTolerance=0",
+       "narval: s.json: renderer.raymarch.msCache.filterTolerance: must be positive, got 0\n"},
+      {"renderer.raymarch.msCache.filter=\\\"wide\\\"",
+       "narval: s.json: renderer.raymarch.msCache.filter: expected a number, got string\n"},
       {"renderer.raymarch.msCache.closure=\\\"hg\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",
        "narval: s.json: renderer.raymarch.msCache.closure: must be \"camera\" with layout \"view\" (its paths aim at "
        "the camera)\n"},

@@ -47,7 +47,8 @@
   F(realtime_params, area_light_phase) F(realtime_params, ms_cache_closure)  \
   F(realtime_params, ms_cache_interpolation) F(realtime_params, ms_cache_layout)                \
   F(realtime_params, ms_cache_tile) F(realtime_params, shadow_weighting) \
-  F(realtime_params, ms_cache_direct) F(realtime_params, pad2)                                \
+  F(realtime_params, ms_cache_direct) F(realtime_params, ms_cache_filter)                     \
+  F(realtime_params, ms_cache_filter_tolerance) F(realtime_params, pad2)                          \
   S(node_grid_params) F(node_grid_params, index_to_world) F(node_grid_params, nx)           \
   F(node_grid_params, ny) F(node_grid_params, nz) F(node_grid_params, pad0)
 

@@ -3,6 +3,7 @@
 // determinism as it is refined.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "render/node_grid.h"
 #include "render/realtime_renderer.h"
 #include "shared/ms_cache.h"
+#include "shared/ms_cache_filter.h"
 #include "shared/ms_cache_view.h"
 #include "render_fixture.h"
 #include "test_support.h"
@@ -63,8 +65,10 @@ TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
     const char* name = !grid ? "box" : grid == &cloud ? "generated cloud" : "Disney cloud";
     // The grid layout, and the view layout (ms_cache_view.h: 4x4 columns of 4x4 pixels, 8 slices):
     // every node of either holds exactly 1, and a view lookup renormalises over the columns that
-    // hold medium, so every pixel whose ray meets density reads 1 as well.
-    for (const std::string layout : {R"("layout": "grid", "resolution": 4)", R"("layout": "view", "tile": 4)"}) {
+    // hold medium, so every pixel whose ray meets density reads 1 as well; so does the view
+    // layout's filter (ms_cache_filter.h: normalised weights of reads that are all 1).
+    for (const std::string layout : {R"("layout": "grid", "resolution": 4)", R"("layout": "view", "tile": 4)",
+                                     R"("layout": "view", "tile": 4, "filter": 1.5)"}) {
       SCOPED_TRACE(layout);
       const RenderResult cached =
           renderRealtime(runtime(), sceneFromJson(furnaceJson("cache", density, layout)), grid, 3, {});
@@ -76,7 +80,8 @@ TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
       double worst = 0;
       for (float v : cached.image.rgb) worst = std::max(worst, std::fabs(v - 1.0));
       std::printf("[ ms cache ] furnace (%s, %s): max |L - 1| %.2g with the cache\n", name,
-                  cached.stats.msCacheView ? "view" : "grid", worst);
+                  !cached.stats.msCacheView ? "grid" : layout.find("filter") != std::string::npos ? "view, filtered" : "view",
+                  worst);
       EXPECT_LE(worst, 1e-5);
     }
 
@@ -141,6 +146,46 @@ TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
     ASSERT_EQ(viewOne[i + 3], 48.0f);
   }
   EXPECT_GT(placed, 0);
+}
+
+// The view layout's filter (ms_cache_filter.h) on the device is the shared code's on the host,
+// applied to the running means, which it leaves as they were: the means with the filter on are
+// those of the same cache without it, bit for bit, and the filtered copy is ms_view_filter_column's
+// over them (within 1e-5 of the value: the device's exp against the host's), its other slots
+// copied. On the lit box at tile 1 with 48 paths the filter changes over half of the channels of
+// the nodes that hold medium (it is not a copy).
+TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
+  Scene scene = litBox();
+  scene.renderer.raymarch.msCache.layout = MsCacheLayout::View;
+  scene.renderer.raymarch.msCache.tile = 1;
+  const std::vector<float> plain = cacheAfter(scene, 48, 16);
+  scene.renderer.raymarch.msCache.filter = 1.5f;
+  scene.renderer.raymarch.msCache.filterTolerance = 2.0f;
+  DeviceSceneBuffers dev(runtime(), scene, nullptr);
+  const realtime_params params = realtimeParams(scene, dev.scene);
+  DeviceMsCache cache;
+  cache.refine(runtime(), dev, params, 48, 16, "lit_box.json");
+  ASSERT_EQ(cache.status(), 0u);
+  std::vector<float> means(plain.size()), device(plain.size()), host(plain.size());
+  runtime().queue.enqueueReadBuffer(cache.means(), CL_TRUE, 0, means.size() * sizeof(float), means.data());
+  runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, device.size() * sizeof(float), device.data());
+  EXPECT_EQ(means, plain);
+  const node_grid_params& c = params.ms_cache;
+  for (int column = 0; column < c.nx * c.ny; ++column)
+    ms_view_filter_column(&c, means.data(), column, 1.5f, 2.0f, host.data() + size_t(column) * MS_CACHE_STRIDE);
+  int changed = 0, withMedium = 0;
+  for (size_t i = 0; i < host.size(); ++i) {
+    withMedium += i % MS_CACHE_STRIDE == MS_VIEW_TAU && means[i] >= 0.0f;
+    if (i % MS_CACHE_STRIDE < 3) {
+      ASSERT_NEAR(device[i], host[i], 1e-5 * std::max(1.0f, std::fabs(host[i]))) << "node " << i / MS_CACHE_STRIDE;
+      changed += std::fabs(device[i] - means[i]) > 1e-3f * std::fabs(means[i]);
+    } else {
+      ASSERT_EQ(device[i], means[i]) << "slot " << i % MS_CACHE_STRIDE;
+    }
+  }
+  std::printf("[ ms cache ] filter: %d of the %d nodes with medium have channels changed by more than 0.1%%\n",
+              changed / 3, withMedium);
+  EXPECT_GT(changed, 3 * withMedium / 2);  // over half of their channels
 }
 
 // refine() to `paths` paths per node for `scene` seen from another camera position, (1, 1, −4).

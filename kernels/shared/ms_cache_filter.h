@@ -1,0 +1,106 @@
+/* ms_cache_filter.h: a filter over the view cache's nodes (ms_cache_view.h) that averages
+ * neighbouring columns where they agree within their noise. A node's paths are few on a 60 s CPU
+ * build (100–700 at 320x240), and their noise is most of the view cache's error; wider tiles
+ * average more paths per pixel but mix columns whose in-scattering differs (at tile 2 the bilinear
+ * mix alone leaves the back-lit Disney cloud at JND 5.1% with 8192 paths a node, tile 1 at 3.0%:
+ * bench/RESULTS.md). What separates columns that may be mixed from those that may not is J itself:
+ * a guide from the single scattering does not (in a cloud of albedo 0.99 most of J is multiple
+ * scattering; the back-lit cloud's dark ring holds none at all), so the range distance is the
+ * nodes' own difference measured in their noise, as in non-local-means filtering of Monte Carlo
+ * renders (Rousselle, Knaus & Zwicker 2012, "Adaptive rendering with non-local means filtering",
+ * Eq. 4 with a patch of one node):
+ *
+ *   d²_j = max(0, (J_j − J)² − (v + v_j)) / (ε + k²·(v + v_j)),
+ *
+ * J, J_j the grey (channel-mean) values, v, v_j the variances of their means (the running mean of
+ * the grey L², MS_CACHE_SQUARE, less J², over the paths n): a neighbour whose difference is within
+ * the noise (d² = 0) weighs as much as the node itself; k (msCache.filterTolerance) sets how many
+ * standard errors beyond it a neighbour keeps e^{−1} of its weight. The filtered node (column
+ * (cx, cy), slice s = [τ_a, τ_b]):
+ *
+ *   J̃ = Σ_j w_j·J_j[τ_a, τ_b] / Σ_j w_j,   w_j = e^{−(Δx² + Δy²)/(2σ_s²)} · e^{−d²_j},
+ *
+ * over the columns j within max(1, ⌊2σ_s⌋) of it on each axis that hold medium; J_j[τ_a, τ_b] is
+ * column j's slices integrated over the node's own τ range (ms_view_lookup with column j alone:
+ * registered by optical depth as the lookup is, so a column whose surface lies deeper is read at
+ * the same depth under its surface, and the node's own column gives its own J̄_s exactly), its
+ * variance that of j's slice holding the node's τ midpoint. σ_s is in columns (msCache.filter; 0:
+ * off). The weights depend on the noise, so the filter is biased where true differences hide in it
+ * (the price of every such denoiser); k → ∞ is a plain Gaussian. The filter reads the running means
+ * and writes a second buffer of the same layout, which the march reads; it runs after every build
+ * launch, so the raw means keep refining and the weights tighten as the noise falls. */
+#ifndef NARVAL_MS_CACHE_FILTER_H
+#define NARVAL_MS_CACHE_FILTER_H
+
+#include "shared/ms_cache_view.h"
+
+#define MS_VIEW_FILTER_EPSILON 1e-20f /* ε: keeps d² finite between noiseless nodes */
+#define MS_VIEW_FILTER_MAX_SLICES 64  /* msCache.slices' upper bound (the loader's) */
+
+/* The grey value of a node and the variance of that mean ("v"). */
+static inline float ms_view_grey(NV_GLOBAL const float* v) { return (v[0] + v[1] + v[2]) * (1.0f / 3.0f); }
+static inline float ms_view_grey_variance(NV_GLOBAL const float* v) {
+  const float J = ms_view_grey(v);
+  return v[3] > 0.0f ? nv_fmax(0.0f, v[MS_CACHE_SQUARE] - J * J) / v[3] : 0.0f;
+}
+
+/* Column j's read over node (column, s)'s τ range, as ms_view_lookup reads one column, and the
+ * variance of j's slice holding that range's midpoint. */
+static inline vec3 ms_view_filter_read(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
+                                       NV_GLOBAL const float* v, int j, NV_PRIVATE float* variance) {
+  const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
+  NV_GLOBAL const float* col = cache + (size_t)j * MS_CACHE_STRIDE;
+  const float a = v[MS_VIEW_TAU], b = v[MS_VIEW_TAU_END], mid = 0.5f * (a + b);
+  int s = 0;
+  while (s + 1 < c->nz && col[(size_t)(s + 1) * slice_stride + MS_VIEW_TAU] <= mid) ++s;
+  *variance = ms_view_grey_variance(col + (size_t)s * slice_stride);
+  ms_view_columns one = {{j, 0, 0, 0}, {1.0f, 0.0f, 0.0f, 0.0f}};
+  return ms_view_lookup(c, cache, &one, a, b - a);
+}
+
+/* Column `column`'s filtered slices ("The filtered column"), σ_s = sigma_s columns, k = tolerance,
+ * written to `out` (the filtered buffer at the column's slice 0: J̃ in slots 0–2, the rest copied);
+ * a column without medium is copied. */
+static inline void ms_view_filter_column(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
+                                         int column, float sigma_s, float tolerance, NV_GLOBAL float* out) {
+  const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
+  const int cx = column % c->nx, cy = column / c->nx, nz = c->nz < MS_VIEW_FILTER_MAX_SLICES ? c->nz : MS_VIEW_FILTER_MAX_SLICES;
+  NV_GLOBAL const float* own = cache + (size_t)column * MS_CACHE_STRIDE;
+  for (int s = 0; s < c->nz; ++s)
+    for (int i = 0; i < MS_CACHE_STRIDE; ++i) out[(size_t)s * slice_stride + i] = own[(size_t)s * slice_stride + i];
+  if (own[MS_VIEW_TAU] < 0.0f || !(sigma_s > 0.0f)) return;
+  const int radius = (int)nv_fmax(1.0f, 2.0f * sigma_s); /* the Gaussian cut at 2σ_s (one column at least) */
+  const float inv_s = 0.5f / (sigma_s * sigma_s), k2 = tolerance * tolerance;
+  vec3 sum[MS_VIEW_FILTER_MAX_SLICES];
+  for (int s = 0; s < nz; ++s) sum[s] = vec3_splat(0.0f);
+  float weight = 0.0f;
+  for (int dy = -radius; dy <= radius; ++dy)
+    for (int dx = -radius; dx <= radius; ++dx) {
+      const int x = cx + dx, y = cy + dy;
+      if (x < 0 || y < 0 || x >= c->nx || y >= c->ny) continue;
+      const int j = x + c->nx * y;
+      if (cache[(size_t)j * MS_CACHE_STRIDE + MS_VIEW_TAU] < 0.0f) continue;
+      float d2 = 0.0f; /* the patch distance: the mean of the slices' */
+      for (int s = 0; s < nz; ++s) {
+        NV_GLOBAL const float* v = own + (size_t)s * slice_stride;
+        float vj;
+        const float diff = vec3_average(ms_view_filter_read(c, cache, v, j, &vj)) - ms_view_grey(v);
+        const float var = ms_view_grey_variance(v) + vj;
+        d2 += nv_fmax(0.0f, diff * diff - var) / (MS_VIEW_FILTER_EPSILON + k2 * var);
+      }
+      const float w = nv_exp(-(float)(dx * dx + dy * dy) * inv_s - d2 / (float)nz);
+      for (int s = 0; s < nz; ++s) {
+        float vj;
+        sum[s] = vec3_add(sum[s], vec3_scale(ms_view_filter_read(c, cache, own + (size_t)s * slice_stride, j, &vj), w));
+      }
+      weight += w;
+    }
+  for (int s = 0; s < nz; ++s) { /* weight ≥ 1: the column itself */
+    NV_GLOBAL float* o = out + (size_t)s * slice_stride;
+    o[0] = sum[s].x / weight;
+    o[1] = sum[s].y / weight;
+    o[2] = sum[s].z / weight;
+  }
+}
+
+#endif
