@@ -21,6 +21,10 @@ parameters and sweeps (full mode; each sweep varies one parameter from the base)
                     (msCache.direct: its paths make the path tracer's next-event estimate at their
                     start; the march makes no light loop): msCache.tile 2,4 (base 2); msCache.slices
                     4,8 (base 8); msCache.paths 128,256,512 (base 256)
+  raymarch-cache-filtered  the same at tiles of 1 pixel with the filter over its nodes
+                    (msCache.filter: columns averaged where they agree within their noise):
+                    msCache.paths 40,160 (base 160); msCache.filter 1,2 (base 1);
+                    msCache.filterTolerance 0.5,2,8 (base 2)
   lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
   lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
 Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
@@ -122,6 +126,11 @@ METHODS = {
                                            "msCache.direct": True},
                               "base": {"msCache.tile": 2, "msCache.slices": 8, "msCache.paths": 256},
                               "style": ("triangle-down", "#666666")},
+    "raymarch-cache-filtered": {"algorithm": "raymarch",
+                                "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.layout": "view",
+                                             "msCache.direct": True, "msCache.tile": 1},
+                                "base": {"msCache.paths": 160, "msCache.filter": 1, "msCache.filterTolerance": 2},
+                                "style": ("circle", "#e41a1c")},
     "lobe-eq7": {"algorithm": "lobe", "settings": {"variant": "eq7"}, "base": {}, "style": ("triangle", "#1b9e77")},
     "lobe-corrected": {"algorithm": "lobe", "settings": {"variant": "corrected"}, "base": {"viewSteps": 16},
                        "style": ("cross", "#7570b3")},
@@ -140,6 +149,8 @@ FULL_SWEEPS = {
     "raymarch-cache-view": {"msCache.tile": [2, 4, 8], "msCache.slices": [4, 8, 16], "msCache.paths": [64, 256, 1024],
                             "shadowWeighting": ["area", "phase"]},
     "raymarch-cache-direct": {"msCache.tile": [2, 4], "msCache.slices": [4, 8], "msCache.paths": [128, 256, 512]},
+    "raymarch-cache-filtered": {"msCache.paths": [40, 160], "msCache.filter": [1, 2],
+                                "msCache.filterTolerance": [0.5, 2, 8]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},
@@ -152,6 +163,7 @@ QUICK_SWEEPS = {
     "raymarch-cache-camera": {"msCache.resolution": [8, 16], "msCache.paths": [64, 256]},
     "raymarch-cache-view": {"msCache.tile": [4, 8], "msCache.paths": [16, 64]},
     "raymarch-cache-direct": {"msCache.tile": [4, 8], "msCache.paths": [16, 64]},
+    "raymarch-cache-filtered": {"msCache.paths": [8, 32]},
     "lobe-eq7": {"lobePoints": [10, 30], "depthFactor": [5, 100], "shadowSteps": [25, 100]},
     "lobe-corrected": {"lobePoints": [10, 30], "lobeRadius": [0.3, 3], "viewSteps": [8, 16]},
 }
@@ -161,7 +173,8 @@ REALTIME_DEFAULTS = {
     "raymarch": {"steps": 60, "shadowSteps": 10, "octaves": 1, "msCache.resolution": 16, "msCache.paths": 256,
                  "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points", "msCache.closure": "linear",
                  "msCache.interpolation": "geometric", "msCache.layout": "grid", "msCache.tile": 4,
-                 "msCache.slices": 8, "shadowWeighting": "area"},
+                 "msCache.slices": 8, "shadowWeighting": "area", "msCache.filter": 0,
+                 "msCache.filterTolerance": 1},
     "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24,
              "areaLightPhase": "points"},
 }

@@ -2,12 +2,14 @@
 # bench/device/ms_cache_gpu.sh [OUTDIR]: on the GPU machine (after `source bench/device/setup.sh`),
 # the multiple-scattering cache against its GPU targets, in one pass that fits a short lease:
 #   1. the real-time picks at 1280x720 (the view cache with the direct light; tiles 4x wider than
-#      the 320x240 picks, so the columns cover the same angle): cache build ms and ms per frame;
+#      the 320x240 picks, so the columns cover the same angle; and with the filter over its nodes,
+#      within a 100 ms build): cache build ms and ms per frame;
 #   2. 320x240 references of the two Disney scenes at REF_SPP (default 131072) with a snapshot at
 #      a quarter (`narval compare --reference-snapshot` reads their own noise back on the CPU);
 #   3. 320x240 view caches with many paths per node (the caches' bias, with their noise gone);
 #   4. 1280x720 references (HD_SPP, snapshot at a quarter) and the JND of every image of 1.
-# Each render has a time limit (Ctrl-C: it writes what it has). The 320x240 images land in
+# STAGES (default "1 2 3 4") picks among them. Each render has a time limit (Ctrl-C: it writes what
+# it has). The 320x240 images land in
 # OUTDIR/images.tar, the numbers in OUTDIR/log.txt. Not a test. Grid storage: the buffer for
 # references (no sampler quantisation), the device's default for the real-time frames.
 set -u
@@ -20,6 +22,7 @@ HD_RES=${HD_RES:-1280x720}
 SCALE_PATHS=${SCALE_PATHS:-1}   # a local dry run divides every path count by this
 LIMIT=${LIMIT:-90}              # seconds per render before Ctrl-C
 DEADLINE=${DEADLINE:-480}       # seconds for the whole pass: later renders get what is left, or none
+STAGES=${STAGES:-1 2 3 4}         # which of the stages below to run
 mkdir -p "$out/img" "$out/hd"
 t0=$(date +%s)
 stamp() { echo "[$(($(date +%s) - t0)) s] $*"; }
@@ -30,11 +33,12 @@ run() {
   timeout -s INT "$limit" "$N" "$@" 2>&1 | grep -v '^narval: progress' | tail -3
 }
 sc() { echo "$PWD/scenes/$1.json"; }
-view() {  # view TILE PATHS STEPS: the view cache with the direct light
+view() {  # view TILE PATHS STEPS [FILTER TOLERANCE]: the view cache with the direct light
   echo --algorithm raymarch --set 'renderer.raymarch.multipleScattering="cache"' \
     --set 'renderer.raymarch.msCache.layout="view"' --set renderer.raymarch.msCache.direct=true \
     --set renderer.raymarch.msCache.tile="$1" --set renderer.raymarch.msCache.paths=$((($2 + SCALE_PATHS - 1) / SCALE_PATHS)) \
-    --set renderer.raymarch.steps="$3"
+    --set renderer.raymarch.steps="$3" --set renderer.raymarch.msCache.filter="${4:-0}" \
+    --set renderer.raymarch.msCache.filterTolerance="${5:-1}"
 }
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null
 "$N" devices
@@ -42,7 +46,7 @@ for s in cloud smoke disney_cloud disney_cloud_front; do  # fills the program ca
   "$N" render "$(sc $s)" -o "$out/warm.exr" --resolution 64x48 $(view 2 32 30) >/dev/null 2>&1 || echo "warm-up failed: $s"
   "$N" render "$(sc $s)" -o "$out/warm.exr" --resolution 64x48 --spp 4 --storage buffer >/dev/null 2>&1 || echo "warm-up failed: pt $s"
 done
-stamp "1. real-time picks at $HD_RES"
+stage() { [[ " $STAGES " == *" $1 "* ]]; }
 hd_configs=(
   "cloud cloud_t8_p400_s24 8 400 24"
   "cloud cloud_t8_p400_s30 8 400 30"
@@ -51,34 +55,43 @@ hd_configs=(
   "disney_cloud back_t4_p640_s30 4 640 30"
   "disney_cloud_front front_t12_p1216_s30 12 1216 30"
   "disney_cloud_front front_t8_p1216_s30 8 1216 30"
+  # With the filter (ms_cache_filter.h), at the 320x240 picks' settings and within a 100 ms build.
+  "cloud cloud_t4_p100_f1.5_k2 4 100 30 1.5 2"
+  "cloud cloud_t8_p100_f1_k2 8 100 30 1 2"
+  "smoke smoke_t8_p100_f1_k2 8 100 30 1 2"
+  "disney_cloud back_t4_p160_f1_k2 4 160 30 1 2"
+  "disney_cloud back_t4_p48_f1_k2 4 48 30 1 2"
+  "disney_cloud_front front_t8_p480_f2_k0.5 8 480 30 2 0.5"
+  "disney_cloud_front front_t8_p160_f2_k0.5 8 160 30 2 0.5"
 )
-for c in "${hd_configs[@]}"; do
+stage 1 && stamp "1. real-time picks at $HD_RES"
+stage 1 && for c in "${hd_configs[@]}"; do
   set -- $c
-  run render "$(sc $1)" -o "$out/hd/$2.exr" --resolution "$HD_RES" --frames 20 $(view $3 $4 $5) \
+  run render "$(sc $1)" -o "$out/hd/$2.exr" --resolution "$HD_RES" --frames 20 $(view $3 $4 $5 ${6:-0} ${7:-1}) \
     --stats-json "$out/hd/$2.json" | grep -v '^wrote'
 done
-stamp "2. 320x240 references at $REF_SPP spp"
-for s in disney_cloud disney_cloud_front; do
+stage 2 && stamp "2. 320x240 references at $REF_SPP spp"
+stage 2 && for s in disney_cloud disney_cloud_front; do
   o=$out/img/ref_$s.exr
   run render "$(sc $s)" -o "$o" --resolution 320x240 --spp $((REF_SPP / 4)) --seed 1 --storage buffer
   cp "$o" "$out/img/ref_${s}_snapshot.exr"
   run render "$(sc $s)" -o "$o" --resolution 320x240 --spp "$REF_SPP" --seed 1 --storage buffer --resume
 done
-stamp "3. 320x240 caches with many paths"
+stage 3 && stamp "3. 320x240 caches with many paths"
 lo_configs=(
   "disney_cloud back_t2_p8192 2 8192"
   "disney_cloud back_t1_p4096 1 4096"
   "disney_cloud_front front_t3_p16384 3 16384"
   "disney_cloud_front front_t2_p8192 2 8192"
 )
-for c in "${lo_configs[@]}"; do
+stage 3 && for c in "${lo_configs[@]}"; do
   set -- $c
   run render "$(sc $1)" -o "$out/img/$2.exr" --resolution 320x240 --frames 3 --seed 1 $(view $3 $4 30) \
     --stats-json "$out/img/$2.json" | grep -v '^wrote'
 done
-(cd "$out/img" && tar -cf "$out/images.tar" ./*.exr ./*.json)
-stamp "4. $HD_RES references at $HD_SPP spp and the JND of the picks"
-for s in cloud smoke disney_cloud disney_cloud_front; do
+(stage 2 || stage 3) && (cd "$out/img" && tar -cf "$out/images.tar" ./*.exr ./*.json)
+stage 4 && stamp "4. $HD_RES references at $HD_SPP spp and the JND of the picks"
+stage 4 && for s in cloud smoke disney_cloud disney_cloud_front; do
   o=$out/hd/ref_$s.exr
   run render "$(sc $s)" -o "$o" --resolution "$HD_RES" --spp $((HD_SPP / 4)) --seed 1 --storage buffer
   cp "$o" "$out/hd/ref_${s}_snapshot.exr"
