@@ -73,8 +73,8 @@ void DeviceMsCache::addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const
     const int count = std::min(std::max(1, pathsPerLaunch), targetPaths - paths_);
     kernel_.set("first", cl_uint(paths_));
     kernel_.set("count", cl_uint(count));
-    buildMs_ +=
-        launchOverNodes(rt, kernel_.get(), nodes, "the multiple-scattering cache", deviceSceneBytes(dev.scene) + bytes_);
+    buildMs_ += launchOverNodes(rt, kernel_.get(), nodes, "the multiple-scattering cache",
+                                deviceSceneBytes(dev.scene) + bytes_);
     paths_ += count;
   }
   status_ |= readStatusWord(rt, statusBuf_);

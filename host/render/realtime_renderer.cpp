@@ -76,7 +76,7 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   }
   if (mc.layout == MsCacheLayout::View) p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA;  // its paths aim at the camera
   p.ms_cache_direct = msCache && mc.direct;
-  if (mc.layout == MsCacheLayout::View) {  // the guided filter over the view nodes (ms_cache_filter.h)
+  if (mc.layout == MsCacheLayout::View) {  // the filter over the view nodes (ms_cache_filter.h)
     p.ms_cache_filter = mc.filter;
     p.ms_cache_filter_tolerance = mc.filterTolerance;
   }

@@ -494,7 +494,8 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
         ctx.fail(mc.keyOf("filter"), "must be at most 8 (columns), got " + formatNumber(s.raymarch.msCache.filter));
       s.raymarch.msCache.filterTolerance = mc.getFloat("filterTolerance", s.raymarch.msCache.filterTolerance);
       if (!(s.raymarch.msCache.filterTolerance > 0))
-        ctx.fail(mc.keyOf("filterTolerance"), "must be positive, got " + formatNumber(s.raymarch.msCache.filterTolerance));
+        ctx.fail(mc.keyOf("filterTolerance"),
+                 "must be positive, got " + formatNumber(s.raymarch.msCache.filterTolerance));
       s.raymarch.msCache.paths = readInt(mc, "paths", s.raymarch.msCache.paths, 1, 1 << 20);
       s.raymarch.msCache.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.raymarch.msCache.pathsPerLaunch, 1, 1 << 20);
       mc.reportUnknown();

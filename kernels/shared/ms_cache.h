@@ -78,7 +78,7 @@
  * sampling alone, 6.1% with the next-event estimate, for 35% more build time.
  *
  * Storage: MS_CACHE_STRIDE floats per node: the running means of the paths so far, R (rgb) then
- * their count, then b for red, green and blue (xyz each, then a free float; the one after red's
+ * their count, then b for red, green and blue (xyz each, then a free float; the one after green's
  * holds the mean of the grey L², MS_CACHE_SQUARE, for the view filter's noise); then what the
  * lookup reads, derived from them by the build after each launch: ln R (rgb, at MS_CACHE_LOG_R)
  * and b/R (at MS_CACHE_RATIO), so that a lookup takes no logarithm or division per corner (the

@@ -8,26 +8,28 @@
  * scattering; the back-lit cloud's dark ring holds none at all), so the range distance is the
  * nodes' own difference measured in their noise, as in non-local-means filtering of Monte Carlo
  * renders (Rousselle, Knaus & Zwicker 2012, "Adaptive rendering with non-local means filtering",
- * Eq. 4 with a patch of one node):
+ * Eq. 4), with the column's slices as the patch:
  *
- *   d²_j = max(0, (J_j − J)² − (v + v_j)) / (ε + k²·(v + v_j)),
+ *   d²_j = (1/nz) Σ_s max(0, (J_j,s − J_s)² − (v_s + v_j,s)) / (ε + k²·(v_s + v_j,s)),
  *
- * J, J_j the grey (channel-mean) values, v, v_j the variances of their means (the running mean of
- * the grey L², MS_CACHE_SQUARE, less J², over the paths n): a neighbour whose difference is within
- * the noise (d² = 0) weighs as much as the node itself; k (msCache.filterTolerance) sets how many
- * standard errors beyond it a neighbour keeps e^{−1} of its weight. The filtered node (column
- * (cx, cy), slice s = [τ_a, τ_b]):
+ * J_s the grey (channel-mean) value of the column's slice s = [τ_a, τ_b], J_j,s column j's slices
+ * integrated over that same τ range (ms_view_lookup with column j alone: registered by optical
+ * depth as the lookup is, so a column whose surface lies deeper is read at the same depth under its
+ * surface, and the column's own reads give its own J̄_s exactly), v_s, v_j,s the variances of those
+ * means (the running mean of the grey L², MS_CACHE_SQUARE, less J², over the paths n; for j, of
+ * its slice holding the range's midpoint): a neighbour whose differences are within the noise
+ * (d² = 0) weighs as much as the column itself; k (msCache.filterTolerance) sets how many standard
+ * errors beyond it a neighbour keeps e^{−1} of its weight. The filtered column:
  *
- *   J̃ = Σ_j w_j·J_j[τ_a, τ_b] / Σ_j w_j,   w_j = e^{−(Δx² + Δy²)/(2σ_s²)} · e^{−d²_j},
+ *   J̃_s = Σ_j w_j·J_j,s / Σ_j w_j,   w_j = e^{−(Δx² + Δy²)/(2σ_s²)} · e^{−d²_j},
  *
- * over the columns j within max(1, ⌊2σ_s⌋) of it on each axis that hold medium; J_j[τ_a, τ_b] is
- * column j's slices integrated over the node's own τ range (ms_view_lookup with column j alone:
- * registered by optical depth as the lookup is, so a column whose surface lies deeper is read at
- * the same depth under its surface, and the node's own column gives its own J̄_s exactly), its
- * variance that of j's slice holding the node's τ midpoint. σ_s is in columns (msCache.filter; 0:
- * off). The weights depend on the noise, so the filter is biased where true differences hide in it
- * (the price of every such denoiser); k → ∞ is a plain Gaussian. The filter reads the running means
- * and writes a second buffer of the same layout, which the march reads; it runs after every build
+ * over the columns j within max(1, ⌊2σ_s⌋) of it on each axis that hold medium, one weight per
+ * column for all its slices. σ_s is in columns (msCache.filter; 0: off). A patch of the column's
+ * slices rather than one node: the distance is less noisy, and measured it is better on two scenes
+ * of three (bench/RESULTS.md). The weights depend on the noise, so the filter is biased where true
+ * differences hide in it (the price of every such denoiser); k → ∞ is a plain Gaussian. The filter
+ * reads the running means and writes a second buffer of the same layout (R filtered, the other
+ * slots copied; the view lookup reads R alone), which the march reads; it runs after every build
  * launch, so the raw means keep refining and the weights tighten as the noise falls. */
 #ifndef NARVAL_MS_CACHE_FILTER_H
 #define NARVAL_MS_CACHE_FILTER_H
@@ -37,7 +39,7 @@
 #define MS_VIEW_FILTER_EPSILON 1e-20f /* ε: keeps d² finite between noiseless nodes */
 #define MS_VIEW_FILTER_MAX_SLICES 64  /* msCache.slices' upper bound (the loader's) */
 
-/* The grey value of a node and the variance of that mean ("v"). */
+/* The grey value of a node and the variance of that mean ("v_s"). */
 static inline float ms_view_grey(NV_GLOBAL const float* v) { return (v[0] + v[1] + v[2]) * (1.0f / 3.0f); }
 static inline float ms_view_grey_variance(NV_GLOBAL const float* v) {
   const float J = ms_view_grey(v);
@@ -64,7 +66,8 @@ static inline vec3 ms_view_filter_read(NV_CONSTANT const node_grid_params* c, NV
 static inline void ms_view_filter_column(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
                                          int column, float sigma_s, float tolerance, NV_GLOBAL float* out) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
-  const int cx = column % c->nx, cy = column / c->nx, nz = c->nz < MS_VIEW_FILTER_MAX_SLICES ? c->nz : MS_VIEW_FILTER_MAX_SLICES;
+  const int cx = column % c->nx, cy = column / c->nx;
+  const int nz = c->nz < MS_VIEW_FILTER_MAX_SLICES ? c->nz : MS_VIEW_FILTER_MAX_SLICES;
   NV_GLOBAL const float* own = cache + (size_t)column * MS_CACHE_STRIDE;
   for (int s = 0; s < c->nz; ++s)
     for (int i = 0; i < MS_CACHE_STRIDE; ++i) out[(size_t)s * slice_stride + i] = own[(size_t)s * slice_stride + i];
@@ -80,7 +83,7 @@ static inline void ms_view_filter_column(NV_CONSTANT const node_grid_params* c, 
       if (x < 0 || y < 0 || x >= c->nx || y >= c->ny) continue;
       const int j = x + c->nx * y;
       if (cache[(size_t)j * MS_CACHE_STRIDE + MS_VIEW_TAU] < 0.0f) continue;
-      float d2 = 0.0f; /* the patch distance: the mean of the slices' */
+      float d2 = 0.0f; /* the patch distance d²_j: the mean of the slices' */
       for (int s = 0; s < nz; ++s) {
         NV_GLOBAL const float* v = own + (size_t)s * slice_stride;
         float vj;

@@ -99,9 +99,11 @@ TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
 // The view layout's filter is reported with its settings (the text line and the stats); given
 // with the grid layout, its keys are named in one warning each and the stats say it is off.
 TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
-  const std::string cache = "--set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.paths=4 "
-                            "--set renderer.raymarch.msCache.filter=1.5 --set renderer.raymarch.msCache.filterTolerance=2 ";
-  RunResult r = run("render s.json -o v.exr --stats-json v.json " + cache + "--set renderer.raymarch.msCache.layout=\\\"view\\\"");
+  const std::string cache =
+      "--set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.paths=4 "
+      "--set renderer.raymarch.msCache.filter=1.5 --set renderer.raymarch.msCache.filterTolerance=2 ";
+  RunResult r = run("render s.json -o v.exr --stats-json v.json " + cache +
+                    "--set renderer.raymarch.msCache.layout=\\\"view\\\"");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   nlohmann::json s = stats("v.json");
@@ -115,9 +117,10 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   r = run("render s.json -o g.exr --stats-json g.json " + cache);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err,
-            "narval: warning: s.json: renderer.raymarch.msCache.filter: applies to layout \"view\"; \"grid\" ignores it\n"
-            "narval: warning: s.json: renderer.raymarch.msCache.filterTolerance: applies to layout \"view\"; \"grid\" "
-            "ignores it\n");
+            "narval: warning: s.json: renderer.raymarch.msCache.filter: applies to layout \"view\"; \"grid\" "
+            "ignores it\n"
+            "narval: warning: s.json: renderer.raymarch.msCache.filterTolerance: applies to layout \"view\"; "
+            "\"grid\" ignores it\n");
   s = stats("g.json");
   EXPECT_EQ(s["ms_cache_filter"], 0.0);
   EXPECT_EQ(s["ms_cache_filter_tolerance"], 0.0);

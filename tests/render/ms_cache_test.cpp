@@ -79,9 +79,9 @@ TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
       EXPECT_EQ(cached.stats.msCacheCells[2], cached.stats.msCacheView ? 8 : 4);
       double worst = 0;
       for (float v : cached.image.rgb) worst = std::max(worst, std::fabs(v - 1.0));
+      const bool filtered = layout.find("filter") != std::string::npos;
       std::printf("[ ms cache ] furnace (%s, %s): max |L - 1| %.2g with the cache\n", name,
-                  !cached.stats.msCacheView ? "grid" : layout.find("filter") != std::string::npos ? "view, filtered" : "view",
-                  worst);
+                  !cached.stats.msCacheView ? "grid" : filtered ? "view, filtered" : "view", worst);
       EXPECT_LE(worst, 1e-5);
     }
 

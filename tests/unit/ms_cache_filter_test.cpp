@@ -132,8 +132,10 @@ TEST(MsCacheFilter, NeighboursAreReadAtTheNodesOwnOpticalDepths) {
   const size_t stride1 = size_t(2) * MS_CACHE_STRIDE;  // slice 1 of a column is nx·ny nodes on
   float* c0 = f.cache.data();
   float* c1 = f.cache.data() + MS_CACHE_STRIDE;
-  c0[MS_VIEW_TAU] = 0.0f, c0[MS_VIEW_TAU_END] = 1.0f, c0[stride1 + MS_VIEW_TAU] = 1.0f, c0[stride1 + MS_VIEW_TAU_END] = 4.6f;
-  c1[MS_VIEW_TAU] = 0.0f, c1[MS_VIEW_TAU_END] = 0.25f, c1[stride1 + MS_VIEW_TAU] = 0.25f, c1[stride1 + MS_VIEW_TAU_END] = 4.6f;
+  c0[MS_VIEW_TAU] = 0.0f, c0[MS_VIEW_TAU_END] = 1.0f;
+  c0[stride1 + MS_VIEW_TAU] = 1.0f, c0[stride1 + MS_VIEW_TAU_END] = 4.6f;
+  c1[MS_VIEW_TAU] = 0.0f, c1[MS_VIEW_TAU_END] = 0.25f;
+  c1[stride1 + MS_VIEW_TAU] = 0.25f, c1[stride1 + MS_VIEW_TAU_END] = 4.6f;
   const std::vector<float> out = filtered(f, 1.0f, 1.0f);
   const double read = (1 * (1 - std::exp(-0.25)) + 3 * (std::exp(-0.25) - std::exp(-1.0))) / (1 - std::exp(-1.0));
   const double w = std::exp(-0.5);
