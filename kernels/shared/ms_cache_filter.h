@@ -74,7 +74,7 @@ static inline void ms_view_filter_column(NV_CONSTANT const node_grid_params* c, 
   if (own[MS_VIEW_TAU] < 0.0f || !(sigma_s > 0.0f)) return;
   const int radius = (int)nv_fmax(1.0f, 2.0f * sigma_s); /* the Gaussian cut at 2σ_s (one column at least) */
   const float inv_s = 0.5f / (sigma_s * sigma_s), k2 = tolerance * tolerance;
-  vec3 sum[MS_VIEW_FILTER_MAX_SLICES];
+  vec3 sum[MS_VIEW_FILTER_MAX_SLICES], read[MS_VIEW_FILTER_MAX_SLICES]; /* read: neighbour j's, per slice */
   for (int s = 0; s < nz; ++s) sum[s] = vec3_splat(0.0f);
   float weight = 0.0f;
   for (int dy = -radius; dy <= radius; ++dy)
@@ -87,15 +87,13 @@ static inline void ms_view_filter_column(NV_CONSTANT const node_grid_params* c, 
       for (int s = 0; s < nz; ++s) {
         NV_GLOBAL const float* v = own + (size_t)s * slice_stride;
         float vj;
-        const float diff = vec3_average(ms_view_filter_read(c, cache, v, j, &vj)) - ms_view_grey(v);
+        read[s] = ms_view_filter_read(c, cache, v, j, &vj);
+        const float diff = vec3_average(read[s]) - ms_view_grey(v);
         const float var = ms_view_grey_variance(v) + vj;
         d2 += nv_fmax(0.0f, diff * diff - var) / (MS_VIEW_FILTER_EPSILON + k2 * var);
       }
       const float w = nv_exp(-(float)(dx * dx + dy * dy) * inv_s - d2 / (float)nz);
-      for (int s = 0; s < nz; ++s) {
-        float vj;
-        sum[s] = vec3_add(sum[s], vec3_scale(ms_view_filter_read(c, cache, own + (size_t)s * slice_stride, j, &vj), w));
-      }
+      for (int s = 0; s < nz; ++s) sum[s] = vec3_add(sum[s], vec3_scale(read[s], w));
       weight += w;
     }
   for (int s = 0; s < nz; ++s) { /* weight ≥ 1: the column itself */
