@@ -12,6 +12,8 @@
 #include "render/realtime_renderer.h"
 #include "render/scene_upload.h"
 #include "render_fixture.h"
+#include "scene/scene.h"
+#include "shared/lobe.h"
 #include "volume/grid.h"
 
 namespace narval::test {
@@ -147,6 +149,52 @@ TEST(LobeCorrected, LobePointsStayInsideTheBox) {
   EXPECT_EQ(near.image.rgb, far.image.rgb);
   for (float v : near.image.rgb) ASSERT_TRUE(std::isfinite(v));
   EXPECT_NE(withRadius(LobeVariant::Eq7, 1e3f).image.rgb, withRadius(LobeVariant::Eq7, 1e6f).image.rgb);
+}
+
+// C4's shortcut (lobe_ball_inside): when it says the ball of radius r about c is inside the box, every
+// lobe point is inside, so skipping the per-point intersection changes no pixel. Checked on a
+// rotated, anisotropically scaled box (its world_to_index has unequal, mixed rows) against
+// medium_intersect along 4096 directions per point: each exit lies at r or beyond. And it is not
+// vacuous: the centre with r a tenth of the smallest half-side is inside, a point within r of a
+// face is not.
+TEST(LobeCorrected, BallInsideTestImpliesEveryLobePointIsInside) {
+  const Scene scene = parseScene(R"({
+    "materials": [{"name": "m", "type": "volume", "scattering": [1, 1, 1], "absorption": [0, 0, 0]}],
+    "primitives": [{"name": "v", "type": "volume",
+                    "transform": {"position": [1, -2, 0.5], "scale": [6, 2, 3], "rotation": [30, -20, 55]},
+                    "materialName": "m"}],
+    "camera": {"position": [0, 0, -20], "lookAt": [0, 0, 0]},
+    "renderer": {"resolution": [2, 2]}
+  })", "rotated_box.json");
+  DenseGrid grid;
+  grid.nx = grid.ny = grid.nz = 2;
+  grid.data.assign(8, 1.0f);
+  grid.maxValue = 1.0f;
+  const DeviceScene ds = buildDeviceScene(scene, &grid);
+  const medium_params& m = ds.params.medium;
+  const vec3 centre = vec3_make(1, -2, 0.5);
+  EXPECT_EQ(lobe_ball_inside(&m, centre, 0.1f), 1);
+  EXPECT_EQ(lobe_ball_inside(&m, centre, 1.01f), 0);  // the half-side along y is 1
+  uint32_t state = 12345u;
+  auto uniform = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / 16777216.0f;
+  };
+  int inside = 0;
+  for (int k = 0; k < 400; ++k) {
+    const vec3 c = vec3_add(centre, vec3_make(4 * uniform() - 2, 2 * uniform() - 1, 2 * uniform() - 1));
+    const float r = 0.05f + 0.6f * uniform();
+    if (!lobe_ball_inside(&m, c, r)) continue;
+    ++inside;
+    for (int i = 0; i < 4096; ++i) {
+      const vec3 d = sample_uniform_sphere(uniform(), uniform());
+      medium_segment seg;
+      ASSERT_TRUE(medium_intersect(&m, c, d, 0.0f, 1e3f, &seg)) << "point " << k;
+      ASSERT_GE(seg.t1, r) << "point " << k << ", direction " << i;
+    }
+  }
+  EXPECT_GT(inside, 40);   // the test ran on many points
+  EXPECT_LT(inside, 400);  // and the bound refused some
 }
 
 }  // namespace
