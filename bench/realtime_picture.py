@@ -73,16 +73,48 @@ def run_narval(narval, args):
     return done.stdout
 
 
+def exr_int_attribute(path, name):
+    """The int attribute `name` of an OpenEXR file's header (None when absent): the header is the magic
+    number and version (8 bytes), then attributes as name\\0 type\\0 size (int32 LE) value, ended by an
+    empty name (OpenEXR's file layout)."""
+    import struct
+    with open(path, "rb") as f:
+        data = f.read(1 << 16)  # narval's headers are a few kilobytes
+    if data[:4] != b"\x76\x2f\x31\x01":
+        raise NarvalError("%s is not an OpenEXR file" % path)
+    at = 8
+    while at < len(data) and data[at] != 0:
+        end = data.index(b"\0", at)
+        key = data[at:end].decode("latin-1")
+        type_end = data.index(b"\0", end + 1)
+        kind = data[end + 1:type_end].decode("latin-1")
+        (size,) = struct.unpack_from("<i", data, type_end + 1)
+        value_at = type_end + 5
+        if key == name and kind == "int" and size == 4:
+            return struct.unpack_from("<i", data, value_at)[0]
+        at = value_at + size
+    return None
+
+
 def reference(settings, name, scene):
-    """REFS/NAME.exr and .png, rendered or continued to --reference-spp when missing or short."""
+    """REFS/NAME.exr and .png: rendered when missing, continued (--resume) to --reference-spp when the
+    EXR holds fewer samples (its narval:spp), used as it is when it holds as many or more (a reference
+    rendered longer elsewhere, on a GPU say)."""
     exr = settings.refs / (name + ".exr")
     png = exr.with_suffix(".png")
-    if exr.is_file() and png.is_file():
+    have = exr_int_attribute(exr, "narval:spp") if exr.is_file() else 0
+    if have is None:
+        raise NarvalError("%s has no narval:spp attribute: not a narval path-traced render" % exr)
+    if have >= settings.reference_spp:
+        if not png.is_file():
+            raise NarvalError("%s holds %d spp but %s is missing; render it again with `narval render %s -o %s "
+                              "--resolution %s --spp %d --seed 1`" % (exr, have, png, scene, exr, RESOLUTION, have))
         return exr, png
     args = ["render", scene, "-o", exr, "--resolution", RESOLUTION, "--spp", settings.reference_spp, "--seed", 1]
-    if exr.is_file():
+    if have > 0:
         args.append("--resume")
-    print("realtime_picture: rendering the reference %s at %d spp" % (exr, settings.reference_spp), flush=True)
+    print("realtime_picture: rendering the reference %s from %d to %d spp" % (exr, have, settings.reference_spp),
+          flush=True)
     run_narval(settings.narval, args)
     return exr, png
 
