@@ -92,6 +92,7 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"ms_cache_ms", s.msCacheMs},
           {"ms_cache_filter", s.msCacheFilter},
           {"ms_cache_filter_tolerance", s.msCacheFilterTolerance},
+          {"ms_cache_guide", s.msCacheGuide},
           {"status",
            {{"nan", (s.status & STATUS_NAN) != 0},
             {"negative_pdf", (s.status & STATUS_NEGATIVE_PDF) != 0},
@@ -292,6 +293,7 @@ int runRender(const RenderArgs& a) {
     if (s.msCacheFilter > 0)
       report << ", filtered (sigma " << s.msCacheFilter << " columns, tolerance " << s.msCacheFilterTolerance
              << " standard errors)";
+    if (s.msCacheGuide > 0) report << ", guided towards the lights (share " << s.msCacheGuide << ")";
     report << " in " << s.msCacheMs << " ms (not in the frame times)\n";
   }
   report << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "

@@ -23,7 +23,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
   std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions() +
                     (towardsCamera ? "camera" : "uniform") + std::to_string(params.ms_cache_layout) + "/" +
-                    std::to_string(params.ms_cache_tile) + (params.ms_cache_direct ? "/direct" : "");
+                    std::to_string(params.ms_cache_tile) + (params.ms_cache_direct ? "/direct" : "") + "/guide" +
+                    rawBytes(params.ms_cache_guide);
   const bool view = params.ms_cache_layout == MS_CACHE_LAYOUT_VIEW;
   filterOn_ = view && params.ms_cache_filter > 0;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);

@@ -76,6 +76,8 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   }
   if (mc.layout == MsCacheLayout::View) p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA;  // its paths aim at the camera
   p.ms_cache_direct = msCache && mc.direct;
+  // The guide draws about the lights where the paths draw from the phase function (phase_guide.h).
+  p.ms_cache_guide = msCache && p.ms_cache_closure == MS_CACHE_CLOSURE_CAMERA ? mc.guide : 0.0f;
   if (mc.layout == MsCacheLayout::View) {  // the filter over the view nodes (ms_cache_filter.h)
     p.ms_cache_filter = mc.filter;
     p.ms_cache_filter_tolerance = mc.filterTolerance;
@@ -214,6 +216,7 @@ RenderResult RealtimeRenderer::result() {
   } else {
     nodeGridCells(params_.ms_cache, st.msCacheCells);
   }
+  st.msCacheGuide = params_.ms_cache_guide;
   result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
   return result;
 }

@@ -95,6 +95,8 @@
 // |                         | σ_s in columns (ms_cache_filter.h)|   |             |                            |
 // |   raymarch.msCache.filterTolerance | number: its k, in     |     | 1           | > 0; view                  |
 // |                         | standard errors                 |     |             |                            |
+// |   raymarch.msCache.guide | number: share of the paths' first |   | 0 (off)     | [0, 1); closure camera or  |
+// |                         | directions drawn towards lights |     |             | layout view (phase_guide.h)|
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
 // |   lobe.variant          | eq7, corrected (lobe.h)         |     | eq7         |                            |
 // |   lobe.depthFactor      | number (eq7)                    |     | 20          | >= 0                       |
@@ -496,6 +498,13 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
       if (!(s.raymarch.msCache.filterTolerance > 0))
         ctx.fail(mc.keyOf("filterTolerance"),
                  "must be positive, got " + formatNumber(s.raymarch.msCache.filterTolerance));
+      s.raymarch.msCache.guide = readNonNegative(mc, "guide", s.raymarch.msCache.guide);
+      if (!(s.raymarch.msCache.guide < 1))
+        ctx.fail(mc.keyOf("guide"), "must be below 1 (the phase function's share covers every direction), got " +
+                                        formatNumber(s.raymarch.msCache.guide));
+      else if (s.raymarch.msCache.guide > 0 && !view && s.raymarch.msCache.closure != MsCacheClosure::Camera)
+        ctx.fail(mc.keyOf("guide"), "needs closure \"camera\" or layout \"view\" (the uniform closures draw no "
+                                    "phase-function directions to guide)");
       s.raymarch.msCache.paths = readInt(mc, "paths", s.raymarch.msCache.paths, 1, 1 << 20);
       s.raymarch.msCache.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.raymarch.msCache.pathsPerLaunch, 1, 1 << 20);
       mc.reportUnknown();

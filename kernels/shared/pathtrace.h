@@ -26,6 +26,7 @@
 #include "shared/light_select.h"
 #include "shared/medium.h"
 #include "shared/phase.h"
+#include "shared/phase_guide.h"
 #include "shared/tracking.h"
 
 /* Transmittance from x to the light point at distance `dist` along unit dir: 0 if another
@@ -46,9 +47,11 @@ static inline vec3 pathtrace_shadow(KERNEL_CONTEXT_PARAM, int light_index, vec3 
 
 /* Light i's next-event estimate at a scattering point x for a path arriving along w_in, divided by
  * the probability of aiming at it (light_select_prob, as the MIS weight of a rectangle hit uses),
- * aimed at the light point that (u1, u2) picks; the shadow ray draws from rng. */
+ * aimed at the light point that (u1, u2) picks; the shadow ray draws from rng. gd: how the event
+ * draws its next direction (phase_guide.h; phase_guide_none(): the phase function), the density MIS
+ * weighs the light's against. */
 static inline vec3 pathtrace_light_at(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 w_in, float u1, float u2,
-                                      NV_PRIVATE rng_state* rng) {
+                                      phase_guide gd, NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
   const float prob = light_select_prob(s, lights, i);
@@ -61,17 +64,19 @@ static inline vec3 pathtrace_light_at(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 
   }
   const vec3 tr = pathtrace_shadow(KERNEL_CONTEXT_ARG, i, x, ls.dir, ls.dist, rng);
   if (vec3_is_zero(tr)) return vec3_splat(0.0f);
-  /* Point light: Le·f·Tr·I/d² / prob. Rectangle: Le·f·Tr/(prob·pdf_light) weighted against phase
-   * sampling, whose pdf is f (sampling is exact). */
+  /* Point light: Le·f·Tr·I/d² / prob. Rectangle: Le·f·Tr/(prob·pdf_light) weighted against the
+   * direction sampling, whose pdf is f (sampling is exact), or the guide's mixture (phase_guide.h). */
   const float light_pdf = prob * ls.pdf;
-  const float w = light_pdf > 0.0f ? mis_power_heuristic(light_pdf, f) / light_pdf : 1.0f / prob;
+  const float w =
+      light_pdf > 0.0f ? mis_power_heuristic(light_pdf, phase_guide_pdf(lights, s->num_lights, gd, f, ls.dir)) / light_pdf
+                       : 1.0f / prob;
   return vec3_scale(vec3_mul(ls.radiance, tr), f * w);
 }
 
 /* pathtrace_light_at with the light point drawn from rng. */
 static inline vec3 pathtrace_light(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 w_in, NV_PRIVATE rng_state* rng) {
   const float u1 = rng_uniform(rng), u2 = rng_uniform(rng);
-  return pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, rng);
+  return pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, phase_guide_none(), rng);
 }
 
 /* The direct light at x (pathtrace_direct, below) with its leading coordinates given: u_select
@@ -79,20 +84,21 @@ static inline vec3 pathtrace_light(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 w_i
  * picks on it); the shadow rays draw from rng. For a caller that stratifies them over many
  * estimates at one point (the multiple-scattering cache's paths, ms_cache_build.h). The path
  * tracer's own events draw everything from rng in turn (pathtrace_direct: one light's numbers after
- * another's shadow ray, no light point drawn when none can be picked), which this cannot share. */
+ * another's shadow ray, no light point drawn when none can be picked), which this cannot share. gd:
+ * how the caller draws the event's next direction (pathtrace_light_at). */
 static inline vec3 pathtrace_direct_at(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, float u_select, float u1, float u2,
-                                       NV_PRIVATE rng_state* rng) {
+                                       phase_guide gd, NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   switch (s->light_sampling) {
     case LIGHT_SAMPLING_ALL: {
       vec3 sum = vec3_splat(0.0f);
       for (int i = 0; i < s->num_lights; ++i)
-        sum = vec3_add(sum, pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, rng));
+        sum = vec3_add(sum, pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, gd, rng));
       return sum;
     }
     case LIGHT_SAMPLING_ONE: {
       const int i = light_select(ctx->lights, s->num_lights, u_select);
-      return i < 0 ? vec3_splat(0.0f) : pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, rng);
+      return i < 0 ? vec3_splat(0.0f) : pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, gd, rng);
     }
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry (scene_kinds.h) */
   }

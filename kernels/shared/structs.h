@@ -174,7 +174,7 @@ typedef struct realtime_params {
   int ms_cache_direct;      /* raymarch: 1: the cache holds the lights' unscattered light too (ms_cache.h, "Direct") */
   float ms_cache_filter;    /* MS_CACHE_LAYOUT_VIEW: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
   float ms_cache_filter_tolerance; /* the filter's k: standard errors a neighbour may differ by (ms_cache_filter.h) */
-  int pad2;
+  float ms_cache_guide;     /* closure camera: share of a path's first direction drawn towards the lights (phase_guide.h) */
 } realtime_params;
 
 typedef struct scene_params {

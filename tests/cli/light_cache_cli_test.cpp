@@ -126,6 +126,27 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   EXPECT_EQ(s["ms_cache_filter_tolerance"], 0.0);
 }
 
+// The guide is reported with its share (the text line and the stats), and 0 without it.
+TEST_F(LightCacheCli, TheGuideIsReported) {
+  const std::string cache =
+      "--set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.paths=4 "
+      "--set renderer.raymarch.msCache.layout=\\\"view\\\" ";
+  RunResult r =
+      run("render s.json -o v.exr --stats-json v.json " + cache + "--set renderer.raymarch.msCache.guide=0.25");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(stats("v.json")["ms_cache_guide"], 0.25);
+  EXPECT_NE(r.out.find("\nmultiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, guided towards "
+                       "the lights (share 0.25) in "),
+            std::string::npos)
+      << r.out;
+  r = run("render s.json -o u.exr --stats-json u.json " + cache);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(stats("u.json")["ms_cache_guide"], 0.0);
+  EXPECT_EQ(r.out.find("guided"), std::string::npos) << r.out;
+  EXPECT_NE(readExr((dir_ / "v.exr").string()).rgb, readExr((dir_ / "u.exr").string()).rgb);
+}
+
 // Moving the point light is a new cache: the image changes where its light reaches the cloud.
 TEST_F(LightCacheCli, MovingALightChangesTheImage) {
   ASSERT_EQ(run("render s.json -o a.exr --stats-json a.json").code, 0);
@@ -192,6 +213,14 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
       {"renderer.raymarch.msCache.direct=true",
        "narval: s.json: renderer.raymarch.msCache.direct: needs closure \"camera\" or layout \"view\" (a node must "
        "hold the light scattered towards the camera)\n"},
+      {"renderer.raymarch.msCache.guide=-0.1",
+       "narval: s.json: renderer.raymarch.msCache.guide: must be non-negative, got -0.1\n"},
+      {"renderer.raymarch.msCache.guide=1 --set renderer.raymarch.msCache.layout=\\\"view\\\"",
+       "narval: s.json: renderer.raymarch.msCache.guide: must be below 1 (the phase function's share covers every "
+       "direction), got 1\n"},
+      {"renderer.raymarch.msCache.guide=0.15",
+       "narval: s.json: renderer.raymarch.msCache.guide: needs closure \"camera\" or layout \"view\" (the uniform "
+       "closures draw no phase-function directions to guide)\n"},
       {"renderer.raymarch.msCache.tile=0", "narval: s.json: renderer.raymarch.msCache.tile: must be at least 1, got 0\n"},
       {"renderer.raymarch.msCache.slices=1",
        "narval: s.json: renderer.raymarch.msCache.slices: must be at least 2, got 1\n"},

@@ -482,5 +482,20 @@ TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracer) {
   expectLitBox(point, "HG 0.8, point light, layout view with the direct light", "the linear closure", 0.3, 0.5);
 }
 
+// The guide (msCache.guide, kernels/shared/phase_guide.h) draws half of each path's first
+// directions about the direction to the light instead of by the phase function, with the weight
+// p/pdf and the mixture's pdf in both MIS weights (the next-event estimate at the node and the
+// rectangle its first segment meets): the same expectation, so the same bound against the path
+// tracer holds with the rectangle light, the case where every weight is in play. A share of 0.5,
+// twice the picks', to make a wrong weight show.
+TEST(MsCache, GuidedViewLayoutMatchesThePathTracer) {
+  const LitBoxCheck rect = checkLitBox(
+      R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true, "guide": 0.5)",
+      R"("layout": "view", "tile": 1, "slices": 16, "direct": true, "guide": 0.5)", "cache", R"("resolution": 8)",
+      kLitBoxPanel);
+  expectLitBox(rect, "HG 0.8, rectangle light, layout view with the direct light, guided", "the linear closure", 0.3,
+               0.5);
+}
+
 }  // namespace
 }  // namespace narval::test
