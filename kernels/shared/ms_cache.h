@@ -84,8 +84,9 @@
  * same. Where a cloud is lit from the camera's side, the light a node sends towards the camera
  * arrives mostly from the lights' side, which the phase function about −w_c points away from.
  * Measured on the front-lit Disney cloud (view, tile 4, 480 paths, direct, unfiltered): the
- * relMSE between two cache seeds 1.88e-3 unguided, 1.01e-3 at share 0.15 and lobes of g 0.6, at
- * the same build time; back-lit 0.85e-3 → 0.81e-3, the default cloud 0.47e-3 → 0.42e-3.
+ * relMSE between two cache seeds 1.88e-3 unguided, 1.01e-3 at share 0.15 and lobes of g 0.6 (the
+ * filtered tile-2 pick: 0.46e-3 → 0.29e-3 at the same build time); back-lit 0.85e-3 → 0.81e-3,
+ * the default cloud 0.47e-3 → 0.42e-3 (bench/RESULTS.md).
  *
  * Storage: MS_CACHE_STRIDE floats per node: the running means of the paths so far, R (rgb) then
  * their count, then b for red, green and blue (xyz each, then a free float; the one after green's
