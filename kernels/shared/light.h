@@ -57,4 +57,16 @@ static inline float light_pdf_rectangle(NV_CONSTANT const light_params* l, vec3 
   return cos_l > 0.0f ? t * t / (cos_l * l->normal.w) : 0.0f;
 }
 
+/* A light's one point: a point light's position, a rectangle's centre (an unknown kind: its corner;
+ * it sends nothing). Where the real-time kernels put a light (march_light_as_point) and where the
+ * cache's guide aims (phase_guide.h). */
+static inline vec3 light_centre(NV_CONSTANT const light_params* l) {
+  const vec3 p = vec3_from4(l->corner);
+  switch (LIGHT_KIND(l)) {
+    case LIGHT_RECTANGLE: return vec3_add(p, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
+    case LIGHT_POINT: return p;
+    default: return p;
+  }
+}
+
 #endif

@@ -11,6 +11,7 @@
 
 #include "shared/emission.h"
 #include "shared/grid.h"
+#include "shared/light.h"
 #include "shared/majorant.h"
 #include "shared/medium.h"
 #include "shared/phase.h"
@@ -213,23 +214,12 @@ static inline vec3 march_emission(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_
 }
 #endif
 
-/* Where the real-time kernels put a light: a point light's position, a rectangle's centre (an
- * unknown kind: its corner; it sends nothing, march_light_as_point). */
-static inline vec3 march_light_position(NV_CONSTANT const light_params* l) {
-  const vec3 p = vec3_from4(l->corner);
-  switch (LIGHT_KIND(l)) {
-    case LIGHT_RECTANGLE: return vec3_add(p, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
-    case LIGHT_POINT: return p;
-    default: return p;
-  }
-}
-
 /* A light as seen from x, as a point: unit direction to it, distance, and the intensity I (W/sr)
  * towards x, so the irradiance-like factor is I / dist². Returns 0 when it sends nothing to x. */
 static inline int march_light_as_point(NV_CONSTANT const light_params* l, vec3 x, NV_PRIVATE vec3* dir,
                                        NV_PRIVATE float* dist, NV_PRIVATE vec3* intensity) {
   vec3 I = vec3_from4(l->radiance);
-  const vec3 to = vec3_sub(march_light_position(l), x);
+  const vec3 to = vec3_sub(light_centre(l), x);
   const float d2 = vec3_dot(to, to);
   if (!(d2 > 0.0f)) return 0;
   *dist = nv_sqrt(d2);
@@ -425,7 +415,7 @@ static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const l
   float w_sum = 0.0f, loss_sum = 0.0f, column_sum = 0.0f; /* loss: Σ w (e^{−σ̄C} − 1), no cancellation */
   for (int j = 0; j < k_side; ++j)
     for (int i = 0; i < k_side; ++i) {
-      const vec3 to = vec3_sub(area ? march_light_area_point(l, i, j, K) : march_light_position(l), x);
+      const vec3 to = vec3_sub(area ? march_light_area_point(l, i, j, K) : light_centre(l), x);
       const float d2 = vec3_dot(to, to);
       if (!(d2 > 0.0f)) {
         if (d2 != d2) *status |= STATUS_NAN;

@@ -36,10 +36,7 @@ static inline phase_guide phase_guide_none(void) {
 
 /* Unit direction from x to light l's centre (a point light's position); 0 when x is there. */
 static inline vec3 phase_guide_axis(NV_CONSTANT const light_params* l, vec3 x) {
-  vec3 c = vec3_from4(l->corner);
-  if (LIGHT_KIND(l) == LIGHT_RECTANGLE)
-    c = vec3_add(c, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
-  const vec3 to = vec3_sub(c, x);
+  const vec3 to = vec3_sub(light_centre(l), x);
   const float d = vec3_length(to);
   return d > 0.0f ? vec3_scale(to, 1.0f / d) : vec3_splat(0.0f);
 }
