@@ -23,8 +23,9 @@ parameters and sweeps (full mode; each sweep varies one parameter from the base)
                     4,8 (base 8); msCache.paths 128,256,512 (base 256)
   raymarch-cache-filtered  the same at tiles of 1 pixel with the filter over its nodes
                     (msCache.filter: columns averaged where they agree within their noise):
-                    msCache.paths 40,160 (base 160); msCache.filter 1,2 (base 1);
-                    msCache.filterTolerance 0.5,2,8 (base 2)
+                    msCache.paths 40,160 (base 160); msCache.filter 1,1.5,2 (base 1);
+                    msCache.filterTolerance 0.5,2,8 (base 2); msCache.filterTwicing false,true
+                    (base false: the filter's residual filtered and added back)
   lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
   lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
 Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
@@ -149,8 +150,8 @@ FULL_SWEEPS = {
     "raymarch-cache-view": {"msCache.tile": [2, 4, 8], "msCache.slices": [4, 8, 16], "msCache.paths": [64, 256, 1024],
                             "shadowWeighting": ["area", "phase"]},
     "raymarch-cache-direct": {"msCache.tile": [2, 4], "msCache.slices": [4, 8], "msCache.paths": [128, 256, 512]},
-    "raymarch-cache-filtered": {"msCache.paths": [40, 160], "msCache.filter": [1, 2],
-                                "msCache.filterTolerance": [0.5, 2, 8]},
+    "raymarch-cache-filtered": {"msCache.paths": [40, 160], "msCache.filter": [1, 1.5, 2],
+                                "msCache.filterTolerance": [0.5, 2, 8], "msCache.filterTwicing": [False, True]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},
@@ -174,7 +175,7 @@ REALTIME_DEFAULTS = {
                  "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points", "msCache.closure": "linear",
                  "msCache.interpolation": "geometric", "msCache.layout": "grid", "msCache.tile": 4,
                  "msCache.slices": 8, "shadowWeighting": "area", "msCache.filter": 0,
-                 "msCache.filterTolerance": 1},
+                 "msCache.filterTolerance": 1, "msCache.filterTwicing": False},
     "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24,
              "areaLightPhase": "points"},
 }

@@ -33,12 +33,13 @@ __kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, __constant realtime_params*
 
 /* The view layout's filter (ms_cache_filter.h): one work-item per column, after every
  * ms_cache_build launch; `filtered` (the cache's layout, a copy of each node with its R filtered)
- * is what the march reads. */
+ * is what the march reads. The weights from `cache`, the values from `values`: the cache itself,
+ * or with `residual` 1 the first pass's output, for twicing's second pass. */
 __kernel void ms_cache_filter_view(__constant realtime_params* params, __global const float* cache,
-                                   __global float* filtered) {
+                                   __global const float* values, int residual, __global float* filtered) {
   const int column = get_global_id(0);
   __constant node_grid_params* c = &params->ms_cache;
   if (column >= c->nx * c->ny) return;
-  ms_view_filter_column(c, cache, column, params->ms_cache_filter, params->ms_cache_filter_tolerance,
-                        filtered + (size_t)column * MS_CACHE_STRIDE);
+  ms_view_filter_column(c, cache, values, residual, column, params->ms_cache_filter,
+                        params->ms_cache_filter_tolerance, filtered + (size_t)column * MS_CACHE_STRIDE);
 }

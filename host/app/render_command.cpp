@@ -92,6 +92,7 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"ms_cache_ms", s.msCacheMs},
           {"ms_cache_filter", s.msCacheFilter},
           {"ms_cache_filter_tolerance", s.msCacheFilterTolerance},
+          {"ms_cache_filter_twicing", s.msCacheFilterTwicing},
           {"ms_cache_guide", s.msCacheGuide},
           {"status",
            {{"nan", (s.status & STATUS_NAN) != 0},
@@ -292,7 +293,7 @@ int runRender(const RenderArgs& a) {
            << " paths per node";
     if (s.msCacheFilter > 0)
       report << ", filtered (sigma " << s.msCacheFilter << " columns, tolerance " << s.msCacheFilterTolerance
-             << " standard errors)";
+             << " standard errors" << (s.msCacheFilterTwicing ? ", twiced" : "") << ")";
     if (s.msCacheGuide > 0) report << ", guided towards the lights (share " << s.msCacheGuide << ")";
     report << " in " << s.msCacheMs << " ms (not in the frame times)\n";
   }

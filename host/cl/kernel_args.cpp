@@ -29,7 +29,7 @@ const std::map<std::string, std::vector<std::string>>& lists() {
       {"light_cache_build", sceneArgsAnd({"params", "light", "cache", "status_word"})},
       {"ms_cache_build", sceneArgsAnd({"params", "first", "count", "cache", "status_word"})},
       {"ms_cache_place_view", sceneArgsAnd({"params", "cache", "status_word"})},
-      {"ms_cache_filter_view", {"params", "cache", "filtered"}},
+      {"ms_cache_filter_view", {"params", "cache", "values", "residual", "filtered"}},
   };
   return all;
 }

@@ -27,6 +27,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
                     rawBytes(params.ms_cache_guide);
   const bool view = params.ms_cache_layout == MS_CACHE_LAYOUT_VIEW;
   filterOn_ = view && params.ms_cache_filter > 0;
+  twicingOn_ = filterOn_ && params.ms_cache_filter_twicing;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
@@ -34,7 +35,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
                                   "x" + std::to_string(c.nz) + " nodes"};
     buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
-    filtered_ = cl::Buffer();  // allocated by the filter when it is on
+    filtered_ = twiced_ = cl::Buffer();  // allocated by the filter when it is on
     filteredKey_.clear();
     rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
     program_ = buildProgram(rt, "ms_cache.cl", dev.buildOptions());
@@ -83,16 +84,27 @@ void DeviceMsCache::addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const
 
 void DeviceMsCache::filter(ClRuntime& rt, const realtime_params& params) {
   if (!filtered_()) filtered_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
-  const std::string key =
-      std::to_string(paths_) + "/" + rawBytes(params.ms_cache_filter) + rawBytes(params.ms_cache_filter_tolerance);
+  if (twicingOn_ && !twiced_()) twiced_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+  const std::string key = std::to_string(paths_) + "/" + rawBytes(params.ms_cache_filter) +
+                          rawBytes(params.ms_cache_filter_tolerance) + (twicingOn_ ? "/twiced" : "");
   if (key == filteredKey_) return;
   NamedKernel filter(program_, "ms_cache_filter_view");
-  const cl::Buffer paramBuf = constantBuffer(rt, params);  // alive until the launch has run
+  const cl::Buffer paramBuf = constantBuffer(rt, params);  // alive until the launches have run
   filter.set("params", paramBuf);
   filter.set("cache", buffer_);
+  const size_t columns = size_t(params.ms_cache.nx) * size_t(params.ms_cache.ny);
+  // S(J), then with twicing 2·S(J) − S(S(J)) from it, the weights both times the running means'
+  // (ms_cache_filter.h, "Twicing").
+  filter.set("values", buffer_);
+  filter.set("residual", cl_int(0));
   filter.set("filtered", filtered_);
-  buildMs_ += launchOverNodes(rt, filter.get(), size_t(params.ms_cache.nx) * size_t(params.ms_cache.ny),
-                              "the multiple-scattering cache", 2 * bytes_);
+  buildMs_ += launchOverNodes(rt, filter.get(), columns, "the multiple-scattering cache", 2 * bytes_);
+  if (twicingOn_) {
+    filter.set("values", filtered_);
+    filter.set("residual", cl_int(1));
+    filter.set("filtered", twiced_);
+    buildMs_ += launchOverNodes(rt, filter.get(), columns, "the multiple-scattering cache", 3 * bytes_);
+  }
   filteredKey_ = key;
 }
 

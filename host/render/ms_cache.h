@@ -23,8 +23,9 @@ class DeviceMsCache {
   void refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params, int targetPaths,
               int pathsPerLaunch, const std::string& sceneFile);
   // What the march reads: the running means, or with the view layout's filter on
-  // (params.ms_cache_filter > 0; kernels/shared/ms_cache_filter.h) their filtered copy.
-  const cl::Buffer& buffer() const { return filterOn_ ? filtered_ : buffer_; }
+  // (params.ms_cache_filter > 0; kernels/shared/ms_cache_filter.h) their filtered copy, twiced
+  // when params.ms_cache_filter_twicing is set.
+  const cl::Buffer& buffer() const { return twicingOn_ ? twiced_ : filterOn_ ? filtered_ : buffer_; }
   const cl::Buffer& means() const { return buffer_; }  // the running means, unfiltered
   int paths() const { return paths_; }             // paths per node so far
   int rebuilds() const { return rebuilds_; }       // times it started over (1 for one scene)
@@ -41,8 +42,8 @@ class DeviceMsCache {
   AllocationSite site_;  // what an allocation failure names (the scene file and key)
   cl::Program program_;
   NamedKernel kernel_;
-  cl::Buffer buffer_, filtered_, sceneBuf_, paramBuf_, statusBuf_;
-  bool filterOn_ = false;
+  cl::Buffer buffer_, filtered_, twiced_, sceneBuf_, paramBuf_, statusBuf_;
+  bool filterOn_ = false, twicingOn_ = false;
   std::string filteredKey_;  // the paths and filter settings the filtered copy was made from
   int paths_ = 0, rebuilds_ = 0;
   double buildMs_ = 0;

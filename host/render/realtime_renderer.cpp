@@ -81,6 +81,7 @@ realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t
   if (mc.layout == MsCacheLayout::View) {  // the filter over the view nodes (ms_cache_filter.h)
     p.ms_cache_filter = mc.filter;
     p.ms_cache_filter_tolerance = mc.filterTolerance;
+    p.ms_cache_filter_twicing = mc.filter > 0 && mc.filterTwicing;
   }
   if (p.ms_cache_direct) p.light_cache = node_grid_params{};  // no light loop: no shadow rays to cache
   switch (r.raymarch.msCache.interpolation) {
@@ -213,6 +214,7 @@ RenderResult RealtimeRenderer::result() {
     st.msCacheCells[2] = params_.ms_cache.nz;
     st.msCacheFilter = params_.ms_cache_filter;
     st.msCacheFilterTolerance = params_.ms_cache_filter > 0 ? params_.ms_cache_filter_tolerance : 0;
+    st.msCacheFilterTwicing = params_.ms_cache_filter_twicing != 0;
   } else {
     nodeGridCells(params_.ms_cache, st.msCacheCells);
   }

@@ -103,6 +103,7 @@ struct RenderStats {
   double msCacheMs = 0;
   // The view layout's filter (kernels/shared/ms_cache_filter.h): σ_s in columns (0: off) and k.
   float msCacheFilter = 0, msCacheFilterTolerance = 0;
+  bool msCacheFilterTwicing = false;
   // The share of the paths' first directions drawn towards the lights (kernels/shared/phase_guide.h).
   float msCacheGuide = 0;
 };

@@ -124,6 +124,7 @@ struct MsCacheSettings {
   // and k, the standard errors by which a neighbour may differ before it loses weight.
   float filter = 0;
   float filterTolerance = 1;
+  bool filterTwicing = false;  // the filter's residual filtered and added back (ms_cache_filter.h, "Twicing")
   // closure "camera" or layout "view": the share of each path's first direction drawn about the
   // directions to the lights instead of by the phase function (kernels/shared/phase_guide.h); 0: none.
   float guide = 0;

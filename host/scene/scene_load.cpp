@@ -95,6 +95,8 @@
 // |                         | σ_s in columns (ms_cache_filter.h)|   |             |                            |
 // |   raymarch.msCache.filterTolerance | number: its k, in     |     | 1           | > 0; view                  |
 // |                         | standard errors                 |     |             |                            |
+// |   raymarch.msCache.filterTwicing | boolean: the filter's  |     | false       | view; needs filter > 0     |
+// |                         | residual filtered, added back   |     |             |                            |
 // |   raymarch.msCache.guide | number: share of the paths' first |   | 0 (off)     | [0, 1); closure camera or  |
 // |                         | directions drawn towards lights |     |             | layout view (phase_guide.h)|
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
@@ -480,8 +482,10 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
           mc.find("closure"))
         ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
       const bool view = s.raymarch.msCache.layout == MsCacheLayout::View;
-      for (const std::string key : {"resolution", "interpolation", "tile", "slices", "filter", "filterTolerance"})
-        if (mc.find(key) && view != (key == "tile" || key == "slices" || key == "filter" || key == "filterTolerance"))
+      for (const std::string key :
+           {"resolution", "interpolation", "tile", "slices", "filter", "filterTolerance", "filterTwicing"})
+        if (mc.find(key) && view != (key == "tile" || key == "slices" || key == "filter" || key == "filterTolerance" ||
+                                     key == "filterTwicing"))
           ctx.warn(mc.keyOf(key), std::string("applies to layout \"") + (view ? "grid" : "view") + "\"; \"" +
                                       (view ? "view" : "grid") + "\" ignores it");
       s.raymarch.msCache.resolution = readInt(mc, "resolution", s.raymarch.msCache.resolution, 1, 256);
@@ -498,6 +502,9 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
       if (!(s.raymarch.msCache.filterTolerance > 0))
         ctx.fail(mc.keyOf("filterTolerance"),
                  "must be positive, got " + formatNumber(s.raymarch.msCache.filterTolerance));
+      s.raymarch.msCache.filterTwicing = mc.getBool("filterTwicing", s.raymarch.msCache.filterTwicing);
+      if (s.raymarch.msCache.filterTwicing && view && !(s.raymarch.msCache.filter > 0))
+        ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
       s.raymarch.msCache.guide = readNonNegative(mc, "guide", s.raymarch.msCache.guide);
       if (!(s.raymarch.msCache.guide < 1))
         ctx.fail(mc.keyOf("guide"), "must be below 1 (the phase function's share covers every direction), got " +

@@ -30,7 +30,20 @@
  * differences hide in it (the price of every such denoiser); k → ∞ is a plain Gaussian. The filter
  * reads the running means and writes a second buffer of the same layout (R filtered, the other
  * slots copied; the view lookup reads R alone), which the march reads; it runs after every build
- * launch, so the raw means keep refining and the weights tighten as the noise falls. */
+ * launch, so the raw means keep refining and the weights tighten as the noise falls.
+ *
+ * Twicing (msCache.filterTwicing; Tukey 1977, "Exploratory Data Analysis", ch. 16): the filter S,
+ * with its weights fixed by the raw means, is linear, and where the in-scattering curves its bias
+ * is (S − I)·J ≈ (m₂/2)·∇²J, m₂ the weights' second moment: a dark column among brighter ones (the
+ * back-lit Disney cloud's ring, where J is convex across the image) reads too bright. Filtering the
+ * residual and adding it back, J̃ = S(J) + S(J − S(J)) = 2·S(J) − S(S(J)), cancels that term (a
+ * field quadratic in the columns comes back exactly, where S alone is off by m₂) for a kernel
+ * 2S − S² that keeps more weight at the centre, so more of the noise. A second pass computes it
+ * from the first pass's output (ms_view_filter_column with `residual` set), with the same weights,
+ * and clamps it at 0 (radiance: where the field dips more sharply than a quadratic, 2S − S² can
+ * overshoot below it). Measured on the back-lit Disney cloud (tile 1, 160 paths; the 8-bit reference
+ * tiles): the filter alone reads the mid-dark bands (reference L* 5–50) +1.1 to +2.0 L* too bright
+ * and JND 5.63%, twiced −0.7 to +0.3 and 5.55% at the same σ_s and k, 5.15% at σ_s 1.5 (bench/RESULTS.md). */
 #ifndef NARVAL_MS_CACHE_FILTER_H
 #define NARVAL_MS_CACHE_FILTER_H
 
@@ -61,10 +74,13 @@ static inline vec3 ms_view_filter_read(NV_CONSTANT const node_grid_params* c, NV
 }
 
 /* Column `column`'s filtered slices ("The filtered column"), σ_s = sigma_s columns, k = tolerance,
- * written to `out` (the filtered buffer at the column's slice 0: J̃ in slots 0–2, the rest copied);
- * a column without medium is copied. */
+ * written to `out` (the filtered buffer at the column's slice 0: J̃ in slots 0–2, the rest copied
+ * from `cache`); a column without medium is copied. The weights come from `cache`, the running
+ * means; the values averaged from `values`: the running means again (S(J)), or with `residual` set
+ * the first pass's output F, and then the column gets 2·F − S(F), at least 0 ("Twicing"). */
 static inline void ms_view_filter_column(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
-                                         int column, float sigma_s, float tolerance, NV_GLOBAL float* out) {
+                                         NV_GLOBAL const float* values, int residual, int column, float sigma_s,
+                                         float tolerance, NV_GLOBAL float* out) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
   const int cx = column % c->nx, cy = column / c->nx;
   const int nz = c->nz < MS_VIEW_FILTER_MAX_SLICES ? c->nz : MS_VIEW_FILTER_MAX_SLICES;
@@ -93,14 +109,23 @@ static inline void ms_view_filter_column(NV_CONSTANT const node_grid_params* c, 
         d2 += nv_fmax(0.0f, diff * diff - var) / (MS_VIEW_FILTER_EPSILON + k2 * var);
       }
       const float w = nv_exp(-(float)(dx * dx + dy * dy) * inv_s - d2 / (float)nz);
-      for (int s = 0; s < nz; ++s) sum[s] = vec3_add(sum[s], vec3_scale(read[s], w));
+      for (int s = 0; s < nz; ++s) {
+        float unused;
+        if (residual) read[s] = ms_view_filter_read(c, values, own + (size_t)s * slice_stride, j, &unused);
+        sum[s] = vec3_add(sum[s], vec3_scale(read[s], w));
+      }
       weight += w;
     }
   for (int s = 0; s < nz; ++s) { /* weight ≥ 1: the column itself */
     NV_GLOBAL float* o = out + (size_t)s * slice_stride;
-    o[0] = sum[s].x / weight;
-    o[1] = sum[s].y / weight;
-    o[2] = sum[s].z / weight;
+    vec3 J = vec3_make(sum[s].x / weight, sum[s].y / weight, sum[s].z / weight);
+    if (residual) {
+      NV_GLOBAL const float* f = values + (size_t)column * MS_CACHE_STRIDE + (size_t)s * slice_stride;
+      J = vec3_max(vec3_splat(0.0f), vec3_sub(vec3_scale(vec3_make(f[0], f[1], f[2]), 2.0f), J));
+    }
+    o[0] = J.x;
+    o[1] = J.y;
+    o[2] = J.z;
   }
 }
 

@@ -175,6 +175,10 @@ typedef struct realtime_params {
   float ms_cache_filter;    /* MS_CACHE_LAYOUT_VIEW: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
   float ms_cache_filter_tolerance; /* the filter's k: standard errors a neighbour may differ by (ms_cache_filter.h) */
   float ms_cache_guide;     /* closure camera: share of a path's first direction drawn towards the lights (phase_guide.h) */
+  int ms_cache_filter_twicing; /* MS_CACHE_LAYOUT_VIEW, filter on: 1: the filter's residual filtered and added back (ms_cache_filter.h, "Twicing") */
+  int pad0;
+  int pad1;
+  int pad2;
 } realtime_params;
 
 typedef struct scene_params {

@@ -109,10 +109,19 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   nlohmann::json s = stats("v.json");
   EXPECT_EQ(s["ms_cache_filter"], 1.5);
   EXPECT_EQ(s["ms_cache_filter_tolerance"], 2.0);
+  EXPECT_EQ(s["ms_cache_filter_twicing"], false);
   EXPECT_EQ(s["nan_pixels"], 0);
   EXPECT_NE(r.out.find("\nmultiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
                        "1.5 columns, tolerance 2 standard errors) in "),
             std::string::npos)
+      << r.out;
+  r = run("render s.json -o t.exr --stats-json t.json " + cache +
+          "--set renderer.raymarch.msCache.layout=\\\"view\\\" --set renderer.raymarch.msCache.filterTwicing=true");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(stats("t.json")["ms_cache_filter_twicing"], true);
+  EXPECT_EQ(stats("t.json")["nan_pixels"], 0);
+  EXPECT_NE(r.out.find(", filtered (sigma 1.5 columns, tolerance 2 standard errors, twiced) in "), std::string::npos)
       << r.out;
   r = run("render s.json -o g.exr --stats-json g.json " + cache);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -230,6 +239,11 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.msCache.filter: must be at most 8 (columns), got 9\n"},
       {"renderer.raymarch.msCache.filterTolerance=0",
        "narval: s.json: renderer.raymarch.msCache.filterTolerance: must be positive, got 0\n"},
+      {"renderer.raymarch.msCache.filterTwicing=true --set renderer.raymarch.msCache.layout=\\\"view\\\"",
+       "narval: s.json: renderer.raymarch.msCache.filterTwicing: needs filter > 0 (it filters the filter's "
+       "residual)\n"},
+      {"renderer.raymarch.msCache.filterTwicing=1",
+       "narval: s.json: renderer.raymarch.msCache.filterTwicing: expected a boolean, got number\n"},
       {"renderer.raymarch.msCache.filter=\\\"wide\\\"",
        "narval: s.json: renderer.raymarch.msCache.filter: expected a number, got string\n"},
       {"renderer.raymarch.msCache.closure=\\\"hg\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",

@@ -49,6 +49,8 @@
   F(realtime_params, ms_cache_tile) F(realtime_params, shadow_weighting) \
   F(realtime_params, ms_cache_direct) F(realtime_params, ms_cache_filter)                     \
   F(realtime_params, ms_cache_filter_tolerance) F(realtime_params, ms_cache_guide)                          \
+  F(realtime_params, ms_cache_filter_twicing) F(realtime_params, pad0) F(realtime_params, pad1)            \
+  F(realtime_params, pad2)                                                                                 \
   S(node_grid_params) F(node_grid_params, index_to_world) F(node_grid_params, nx)           \
   F(node_grid_params, ny) F(node_grid_params, nz) F(node_grid_params, pad0)
 

@@ -172,7 +172,8 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   EXPECT_EQ(means, plain);
   const node_grid_params& c = params.ms_cache;
   for (int column = 0; column < c.nx * c.ny; ++column)
-    ms_view_filter_column(&c, means.data(), column, 1.5f, 2.0f, host.data() + size_t(column) * MS_CACHE_STRIDE);
+    ms_view_filter_column(&c, means.data(), means.data(), 0, column, 1.5f, 2.0f,
+                          host.data() + size_t(column) * MS_CACHE_STRIDE);
   int changed = 0, withMedium = 0;
   for (size_t i = 0; i < host.size(); ++i) {
     withMedium += i % MS_CACHE_STRIDE == MS_VIEW_TAU && means[i] >= 0.0f;
@@ -186,6 +187,35 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   std::printf("[ ms cache ] filter: %d of the %d nodes with medium have channels changed by more than 0.1%%\n",
               changed / 3, withMedium);
   EXPECT_GT(changed, 3 * withMedium / 2);  // over half of their channels
+
+  // Twiced (ms_cache_filter.h, "Twicing"): the device's second pass is the shared code's over the
+  // host's first pass, the weights again the means' (within 3e-5: two passes of exp rounding).
+  scene.renderer.raymarch.msCache.filterTwicing = true;
+  const realtime_params twicing = realtimeParams(scene, dev.scene);
+  ASSERT_EQ(twicing.ms_cache_filter_twicing, 1);
+  DeviceMsCache twicedCache;
+  twicedCache.refine(runtime(), dev, twicing, 48, 16, "lit_box.json");
+  ASSERT_EQ(twicedCache.status(), 0u);
+  std::vector<float> twicedDevice(plain.size()), twicedHost(plain.size());
+  runtime().queue.enqueueReadBuffer(twicedCache.buffer(), CL_TRUE, 0, twicedDevice.size() * sizeof(float),
+                                    twicedDevice.data());
+  for (int column = 0; column < c.nx * c.ny; ++column)
+    ms_view_filter_column(&c, means.data(), host.data(), 1, column, 1.5f, 2.0f,
+                          twicedHost.data() + size_t(column) * MS_CACHE_STRIDE);
+  int twicedChanged = 0;
+  for (size_t i = 0; i < twicedHost.size(); ++i) {
+    if (i % MS_CACHE_STRIDE < 3) {
+      ASSERT_NEAR(twicedDevice[i], twicedHost[i], 3e-5 * std::max(1.0f, std::fabs(twicedHost[i])))
+          << "node " << i / MS_CACHE_STRIDE;
+      ASSERT_GE(twicedDevice[i], 0.0f);
+      twicedChanged += std::fabs(twicedDevice[i] - host[i]) > 1e-3f * std::fabs(host[i]);
+    } else {
+      ASSERT_EQ(twicedDevice[i], means[i]) << "slot " << i % MS_CACHE_STRIDE;
+    }
+  }
+  std::printf("[ ms cache ] twiced: %d of the %d nodes with medium differ from the filtered copy by more than 0.1%%\n",
+              twicedChanged / 3, withMedium);
+  EXPECT_GT(twicedChanged, 3 * withMedium / 2);
 }
 
 // refine() to `paths` paths per node for `scene` seen from another camera position, (1, 1, −4).

@@ -45,7 +45,17 @@ FilterCase filterCase(int nx, int ny, int nz, const std::function<float(int)>& t
 std::vector<float> filtered(const FilterCase& f, float sigma, float tolerance) {
   std::vector<float> out(f.cache.size());
   for (int column = 0; column < f.c.nx * f.c.ny; ++column)
-    ms_view_filter_column(&f.c, f.cache.data(), column, sigma, tolerance,
+    ms_view_filter_column(&f.c, f.cache.data(), f.cache.data(), 0, column, sigma, tolerance,
+                          out.data() + size_t(column) * MS_CACHE_STRIDE);
+  return out;
+}
+
+// Twiced: the second pass over the first's output, with the running means' weights ("Twicing").
+std::vector<float> twiced(const FilterCase& f, float sigma, float tolerance) {
+  const std::vector<float> first = filtered(f, sigma, tolerance);
+  std::vector<float> out(f.cache.size());
+  for (int column = 0; column < f.c.nx * f.c.ny; ++column)
+    ms_view_filter_column(&f.c, f.cache.data(), first.data(), 1, column, sigma, tolerance,
                           out.data() + size_t(column) * MS_CACHE_STRIDE);
   return out;
 }
@@ -68,10 +78,45 @@ TEST(MsCacheFilter, AConstantFieldIsUnchanged) {
   const FilterCase f = filterCase(5, 4, 3, kEvenSlices, [](int, int, int) { return 2.5f; }, 0.1f);
   for (float sigma : {0.5f, 1.0f, 3.0f})
     for (float k : {0.25f, 1.0f, 8.0f}) {
-      const std::vector<float> out = filtered(f, sigma, k);
-      for (size_t i = 0; i < out.size(); ++i)
-        ASSERT_FLOAT_EQ(out[i], f.cache[i]) << "slot " << i % MS_CACHE_STRIDE << ", sigma " << sigma << ", k " << k;
+      for (const std::vector<float>& out : {filtered(f, sigma, k), twiced(f, sigma, k)})
+        for (size_t i = 0; i < out.size(); ++i)
+          ASSERT_FLOAT_EQ(out[i], f.cache[i]) << "slot " << i % MS_CACHE_STRIDE << ", sigma " << sigma << ", k " << k;
     }
+}
+
+// Twicing cancels the blur's bias on a curved field. J = 1 + 0.01·((cx − 4)² + (cy − 4)²) on 9x9
+// columns, variance 1 (every Δ² ≤ 0.32² < 2v: d² = 0, the weights are the Gaussian's). σ_s = 1 cuts
+// the Gaussian at radius 2, and its weights factor over the axes, so S adds the discrete second
+// moment per axis times the curvature: S(J) = J + 0.01·2·m₂, m₂ = Σ_{|d|≤2} d²e^{−d²/2} / Σ_{|d|≤2}
+// e^{−d²/2} = 2(e^{−1/2} + 4e^{−2}) / (1 + 2e^{−1/2} + 2e^{−2}) = 0.92431 (a quadratic's S is the
+// quadratic plus a constant). S(S(J)) = J + 2·(0.01·2·m₂), so 2·S(J) − S(S(J)) = J exactly, at every
+// column whose twice-widened window (radius 4) stays inside the image: the centre.
+TEST(MsCacheFilter, TwicingReproducesAQuadraticFieldWhereTheFilterIsOffByItsSecondMoment) {
+  auto value = [](int cx, int cy, int) { return 1.0f + 0.01f * float((cx - 4) * (cx - 4) + (cy - 4) * (cy - 4)); };
+  const FilterCase f = filterCase(9, 9, 2, kEvenSlices, value, 1.0f);
+  const double m2 = 2 * (std::exp(-0.5) + 4 * std::exp(-2.0)) / (1 + 2 * std::exp(-0.5) + 2 * std::exp(-2.0));
+  const std::vector<float> plain = filtered(f, 1.0f, 1.0f), twice = twiced(f, 1.0f, 1.0f);
+  for (int s = 0; s < 2; ++s) {
+    EXPECT_NEAR(at(f, plain, 4, 4, s), 1.0 + 0.01 * 2 * m2, 1e-5) << "slice " << s;
+    EXPECT_NEAR(at(f, twice, 4, 4, s), 1.0, 1e-5) << "slice " << s;
+  }
+  // Off the centre the first pass is still J + 0.01·2·m₂ where its own window (radius 2) fits.
+  EXPECT_NEAR(at(f, plain, 2, 5, 0), value(2, 5, 0) + 0.01 * 2 * m2, 1e-5);
+}
+
+// Twicing's kernel 2S − S² is negative beyond S's radius, so next to a dark hole it can fall below
+// 0, which radiance cannot: J = 0 on the 5x5 centre of 9x9 columns and 1 around it, variance 1 (the
+// Gaussian's weights, σ_s = 1, radius 2). The centre's S(J) is 0 (its window is the hole), S(S(J))
+// there takes S(J) of columns such as (6, 4), which reach the 1s: 2·0 − S(S(J)) < 0, written as 0.
+TEST(MsCacheFilter, TwicingIsClampedAtZero) {
+  auto value = [](int cx, int cy, int) { return std::abs(cx - 4) <= 2 && std::abs(cy - 4) <= 2 ? 0.0f : 1.0f; };
+  const FilterCase f = filterCase(9, 9, 1, kEvenSlices, value, 1.0f);
+  const std::vector<float> plain = filtered(f, 1.0f, 1.0f), twice = twiced(f, 1.0f, 1.0f);
+  EXPECT_EQ(at(f, plain, 4, 4, 0), 0.0f);
+  EXPECT_GT(at(f, plain, 6, 4, 0), 0.1f);  // S(S(J)) at the centre is positive
+  EXPECT_EQ(at(f, twice, 4, 4, 0), 0.0f);
+  for (int cy = 0; cy < 9; ++cy)
+    for (int cx = 0; cx < 9; ++cx) EXPECT_GE(at(f, twice, cx, cy, 0), 0.0f) << cx << "," << cy;
 }
 
 // Two columns, one slice each: J = 1 and 1 + Δ, each of variance v. With Δ² = (1 + k²)·2v the
