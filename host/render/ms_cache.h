@@ -42,7 +42,7 @@ class DeviceMsCache {
   AllocationSite site_;  // what an allocation failure names (the scene file and key)
   cl::Program program_;
   NamedKernel kernel_;
-  cl::Buffer buffer_, filtered_, twiced_, sceneBuf_, paramBuf_, statusBuf_;
+  cl::Buffer buffer_, filtered_, twiced_, sceneBuf_, majorantBuf_, paramBuf_, statusBuf_;
   bool filterOn_ = false, twicingOn_ = false;
   std::string filteredKey_;  // the paths and filter settings the filtered copy was made from
   int paths_ = 0, rebuilds_ = 0;
