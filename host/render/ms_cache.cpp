@@ -44,7 +44,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
     // The paths are the path tracer's, so they walk its majorant grid (majorant_options.h: 32 cells
     // on CPUs, where it measured best), not the march's 16 cells, whose occupied cells place the
     // march's samples. Measured on the back-lit Disney cloud (view, tile 4, 480 paths): the build
-    // 13.3 s → 11.6 s (bench/RESULTS.md).
+    // 13.3 s → 11.7–12.1 s (bench/RESULTS.md).
     DeviceScene walked = dev.scene;
     setMajorantResolution(walked, pathtraceMajorantResolution(rt.selected.info));
     pathScene.medium.majorant_grid = walked.params.medium.majorant_grid;
