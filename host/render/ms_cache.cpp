@@ -41,15 +41,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
     rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
     program_ = buildProgram(rt, "ms_cache.cl", dev.buildOptions());
     kernel_ = NamedKernel(program_, "ms_cache_build");
-    // The paths are the path tracer's, so they walk its majorant grid (majorant_options.h: 32 cells
-    // on CPUs, where it measured best), not the march's 16 cells, whose occupied cells place the
-    // march's samples. Measured on the back-lit Disney cloud (view, tile 4, 480 paths): the build
-    // 13.3 s → 11.7–12.1 s (bench/RESULTS.md).
-    DeviceScene walked = dev.scene;
-    setMajorantResolution(walked, pathtraceMajorantResolution(rt.selected.info));
-    pathScene.medium.majorant_grid = walked.params.medium.majorant_grid;
-    majorantBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                              sizeof(float) * walked.majorants.size(), walked.majorants.data());
+    walkMajorants(rt, dev, pathScene);
     sceneBuf_ = constantBuffer(rt, pathScene);
     statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
     rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
@@ -71,6 +63,28 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
   }
   if (paths_ < targetPaths) addPaths(rt, dev, params, targetPaths, pathsPerLaunch);
   if (filterOn_) filter(rt, params);
+}
+
+// The paths are the path tracer's, so they walk its majorant grid (majorant_options.h: 32 cells on
+// CPUs, where it measured best), not the march's 16 cells, whose occupied cells place the march's
+// samples. Measured on the back-lit Disney cloud (view, tile 4, 480 paths): the build 13.3 s →
+// 11.7–12.1 s (bench/RESULTS.md). Built once per grid (1–2 ms on the Disney cloud, in proportion to
+// the voxels), not at every start-over: the view cache starts over whenever the camera moves.
+void DeviceMsCache::walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene) {
+  const int target = pathtraceMajorantResolution(rt.selected.info);
+  const std::string key = rawBytes(dev.scene.grid) + "/" + std::to_string(target);
+  if (key != walkedKey_) {
+    DeviceScene walked = dev.scene;
+    walkedOwn_ = setMajorantResolution(walked, target);  // false: no grid, or the march's is that one
+    if (walkedOwn_) {
+      walkedGrid_ = walked.params.medium.majorant_grid;
+      walkedBuf_ = cl::Buffer(rt.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                              sizeof(float) * walked.majorants.size(), walked.majorants.data());
+    }
+    walkedKey_ = key;
+  }
+  if (walkedOwn_) pathScene.medium.majorant_grid = walkedGrid_;
+  majorantBuf_ = walkedOwn_ ? walkedBuf_ : dev.majorantBuf;
 }
 
 void DeviceMsCache::addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params,

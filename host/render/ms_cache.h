@@ -36,13 +36,19 @@ class DeviceMsCache {
  private:
   void addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params, int targetPaths,
                 int pathsPerLaunch);
-  void filter(ClRuntime& rt, const realtime_params& params);  // the filtered copy, when the paths or settings changed
+  void filter(ClRuntime& rt, const realtime_params& params);
+  // The majorant grid the paths walk into pathScene and majorantBuf_ (ms_cache.cpp).
+  void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);  // the filtered copy, when the paths or settings changed
 
   std::string key_;
   AllocationSite site_;  // what an allocation failure names (the scene file and key)
   cl::Program program_;
   NamedKernel kernel_;
   cl::Buffer buffer_, filtered_, twiced_, sceneBuf_, majorantBuf_, paramBuf_, statusBuf_;
+  std::string walkedKey_;                // the grid and resolution walkedBuf_ was built for
+  bool walkedOwn_ = false;               // the paths walk walkedGrid_ (else the march's grid)
+  majorant_grid_params walkedGrid_{};
+  cl::Buffer walkedBuf_;
   bool filterOn_ = false, twicingOn_ = false;
   std::string filteredKey_;  // the paths and filter settings the filtered copy was made from
   int paths_ = 0, rebuilds_ = 0;

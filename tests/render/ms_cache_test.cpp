@@ -518,8 +518,9 @@ TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracer) {
 // the path tracer's resolution (32 cells on CPUs; the march keeps 16: render/ms_cache.cpp), and a
 // grid bound to the wrong cells, or a bound below the density, would bias them against the path
 // tracer, which takes its own (measured: with the paths' majorants halved the worst |error|/bound
-// is 9.9, against 0.50 as built; the widest bound 16% of the value). No wisps: a field that fades inside a pixel reads differently through
-// the march's one ray at the pixel's centre than through the path tracer's rays jittered over it.
+// is 9.9, against 0.50 as built; the widest bound 16% of the value). No wisps: a field that fades
+// inside a pixel reads differently through the march's one ray at the pixel's centre than through
+// the path tracer's rays jittered over it.
 TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracerInAHeterogeneousMedium) {
   DenseGrid ramp;
   ramp.nx = ramp.ny = ramp.nz = 32;
