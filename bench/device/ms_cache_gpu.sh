@@ -6,7 +6,8 @@
 #      within a 100 ms build): cache build ms and ms per frame;
 #   2. 320x240 references of the two Disney scenes at REF_SPP (default 131072) with a snapshot at
 #      a quarter (`narval compare --reference-snapshot` reads their own noise back on the CPU);
-#   3. 320x240 view caches with many paths per node (the caches' bias, with their noise gone);
+#   3. 320x240 view caches with many paths per node (the caches' bias, with their noise gone), and
+#      the CPU picks of the Disney scenes, to judge against the float references of 2;
 #   4. 1280x720 references (HD_SPP, snapshot at a quarter) and the JND of every image of 1.
 # STAGES (default "1 2 3 4") picks among them. Each render has a time limit (Ctrl-C: it writes what
 # it has). The 320x240 images land in
@@ -33,12 +34,13 @@ run() {
   timeout -s INT "$limit" "$N" "$@" 2>&1 | grep -v '^narval: progress' | tail -3
 }
 sc() { echo "$PWD/scenes/$1.json"; }
-view() {  # view TILE PATHS STEPS [FILTER TOLERANCE]: the view cache with the direct light
+view() {  # view TILE PATHS STEPS [FILTER TOLERANCE TWICING GUIDE]: the view cache with the direct light
   echo --algorithm raymarch --set 'renderer.raymarch.multipleScattering="cache"' \
     --set 'renderer.raymarch.msCache.layout="view"' --set renderer.raymarch.msCache.direct=true \
     --set renderer.raymarch.msCache.tile="$1" --set renderer.raymarch.msCache.paths=$((($2 + SCALE_PATHS - 1) / SCALE_PATHS)) \
     --set renderer.raymarch.steps="$3" --set renderer.raymarch.msCache.filter="${4:-0}" \
-    --set renderer.raymarch.msCache.filterTolerance="${5:-1}"
+    --set renderer.raymarch.msCache.filterTolerance="${5:-1}" \
+    --set renderer.raymarch.msCache.filterTwicing="${6:-false}" --set renderer.raymarch.msCache.guide="${7:-0}"
 }
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null
 "$N" devices
@@ -63,11 +65,17 @@ hd_configs=(
   "disney_cloud back_t4_p48_f1_k2 4 48 30 1 2"
   "disney_cloud_front front_t8_p480_f2_k0.5 8 480 30 2 0.5"
   "disney_cloud_front front_t8_p160_f2_k0.5 8 160 30 2 0.5"
+  # The 320x240 picks of the Disney scenes (README), twiced (back-lit) and guided (front-lit), at
+  # 4x the tile, and with fewer paths for a 100 ms build.
+  "disney_cloud back_t4_p176_f1.5_k2_twiced 4 176 30 1.5 2 true"
+  "disney_cloud back_t4_p48_f1.5_k2_twiced 4 48 30 1.5 2 true"
+  "disney_cloud_front front_t8_p480_f2_k0.5_g0.15 8 480 30 2 0.5 false 0.15"
+  "disney_cloud_front front_t8_p160_f2_k0.5_g0.15 8 160 30 2 0.5 false 0.15"
 )
 stage 1 && stamp "1. real-time picks at $HD_RES"
 stage 1 && for c in "${hd_configs[@]}"; do
   set -- $c
-  run render "$(sc $1)" -o "$out/hd/$2.exr" --resolution "$HD_RES" --frames 20 $(view $3 $4 $5 ${6:-0} ${7:-1}) \
+  run render "$(sc $1)" -o "$out/hd/$2.exr" --resolution "$HD_RES" --frames 20 $(view $3 $4 $5 ${6:-0} ${7:-1} ${8:-false} ${9:-0}) \
     --stats-json "$out/hd/$2.json" | grep -v '^wrote'
 done
 stage 2 && stamp "2. 320x240 references at $REF_SPP spp"
@@ -81,12 +89,14 @@ stage 3 && stamp "3. 320x240 caches with many paths"
 lo_configs=(
   "disney_cloud back_t2_p8192 2 8192"
   "disney_cloud back_t1_p4096 1 4096"
+  "disney_cloud back_t1_p176_f1.5_k2_twiced 1 176 1.5 2 true"
+  "disney_cloud_front front_t2_p480_f2_k0.5_g0.15 2 480 2 0.5 false 0.15"
   "disney_cloud_front front_t3_p16384 3 16384"
   "disney_cloud_front front_t2_p8192 2 8192"
 )
 stage 3 && for c in "${lo_configs[@]}"; do
   set -- $c
-  run render "$(sc $1)" -o "$out/img/$2.exr" --resolution 320x240 --frames 3 --seed 1 $(view $3 $4 30) \
+  run render "$(sc $1)" -o "$out/img/$2.exr" --resolution 320x240 --frames 3 --seed 1 $(view $3 $4 30 ${5:-0} ${6:-1} ${7:-false} ${8:-0}) \
     --stats-json "$out/img/$2.json" | grep -v '^wrote'
 done
 (stage 2 || stage 3) && (cd "$out/img" && tar -cf "$out/images.tar" ./*.exr ./*.json)
