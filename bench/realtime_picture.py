@@ -34,9 +34,9 @@ SCENES = [("cloud", "scenes/cloud.json"), ("smoke", "scenes/smoke.json"),
           ("disney_cloud", "scenes/disney_cloud.json"), ("disney_cloud_front", "scenes/disney_cloud_front.json")]
 
 
-def view_cache(tile, paths, sigma, tolerance, guide=0.0, twicing=False):
-    """The view cache with the direct light, the filter (twiced or not) and the guide (README,
-    bench/RESULTS.md)."""
+def view_cache(tile, paths, sigma, tolerance, guide=0.0, twicing=False, allocation="even"):
+    """The view cache with the direct light, the filter (twiced or not), the guide and the paths'
+    allocation over the columns (README, bench/RESULTS.md)."""
     return ["--algorithm", "raymarch", "--set", 'renderer.raymarch.multipleScattering="cache"',
             "--set", 'renderer.raymarch.msCache.layout="view"', "--set", "renderer.raymarch.msCache.direct=true",
             "--set", "renderer.raymarch.msCache.tile=%d" % tile, "--set", "renderer.raymarch.msCache.paths=%d" % paths,
@@ -44,12 +44,13 @@ def view_cache(tile, paths, sigma, tolerance, guide=0.0, twicing=False):
             "--set", "renderer.raymarch.msCache.filterTolerance=%g" % tolerance,
             "--set", "renderer.raymarch.msCache.filterTwicing=%s" % ("true" if twicing else "false"),
             "--set", "renderer.raymarch.msCache.guide=%g" % guide,
+            "--set", 'renderer.raymarch.msCache.allocation="%s"' % allocation,
             "--set", "renderer.raymarch.steps=30"]
 
 
 # The cache's pick per scene (a build under 60 s on 2 CPU cores; bench/RESULTS.md).
 CACHE_PICKS = {"cloud": view_cache(1, 100, 1.5, 2), "smoke": view_cache(1, 100, 1.5, 2),
-               "disney_cloud": view_cache(1, 176, 1.5, 2, twicing=True),
+               "disney_cloud": view_cache(1, 136, 1.5, 2, twicing=True, allocation="perceptual"),
                "disney_cloud_front": view_cache(2, 480, 2, 0.5, 0.15)}
 METHODS = [
     ("raymarch, single scattering", lambda scene: ["--algorithm", "raymarch", "--set",

@@ -25,7 +25,8 @@ parameters and sweeps (full mode; each sweep varies one parameter from the base)
                     (msCache.filter: columns averaged where they agree within their noise):
                     msCache.paths 40,160 (base 160); msCache.filter 1,1.5,2 (base 1);
                     msCache.filterTolerance 0.5,2,8 (base 2); msCache.filterTwicing false,true
-                    (base false: the filter's residual filtered and added back)
+                    (base false: the filter's residual filtered and added back); msCache.allocation
+                    even,perceptual (base even: the paths spread over the columns by what the eye sees)
   lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
   lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
 Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
@@ -151,7 +152,8 @@ FULL_SWEEPS = {
                             "shadowWeighting": ["area", "phase"]},
     "raymarch-cache-direct": {"msCache.tile": [2, 4], "msCache.slices": [4, 8], "msCache.paths": [128, 256, 512]},
     "raymarch-cache-filtered": {"msCache.paths": [40, 160], "msCache.filter": [1, 1.5, 2],
-                                "msCache.filterTolerance": [0.5, 2, 8], "msCache.filterTwicing": [False, True]},
+                                "msCache.filterTolerance": [0.5, 2, 8], "msCache.filterTwicing": [False, True],
+                                "msCache.allocation": ["even", "perceptual"]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},

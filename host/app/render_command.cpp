@@ -94,6 +94,7 @@ nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
           {"ms_cache_filter_tolerance", s.msCacheFilterTolerance},
           {"ms_cache_filter_twicing", s.msCacheFilterTwicing},
           {"ms_cache_guide", s.msCacheGuide},
+          {"ms_cache_budget", {s.msCacheBudgetMin, s.msCacheBudgetMax}},
           {"status",
            {{"nan", (s.status & STATUS_NAN) != 0},
             {"negative_pdf", (s.status & STATUS_NEGATIVE_PDF) != 0},
@@ -289,12 +290,15 @@ int runRender(const RenderArgs& a) {
               << s.lightCacheMs << " ms (not in the frame times)\n";
   if (s.msCacheBuilds > 0) {
     report << "multiple-scattering cache: " << s.msCacheCells[0] << "x" << s.msCacheCells[1] << "x"
-           << s.msCacheCells[2] << (s.msCacheView ? " columns x rows x slices, " : " cells, ") << s.msCachePaths
+           << s.msCacheCells[2] << (s.msCacheView ? " columns x rows x slices, " : " cells, ")
+           << (s.msCacheBudgetMax > 0 ? "a mean of " : "") << s.msCachePaths
            << " paths per node";
     if (s.msCacheFilter > 0)
       report << ", filtered (sigma " << s.msCacheFilter << " columns, tolerance " << s.msCacheFilterTolerance
              << " standard errors" << (s.msCacheFilterTwicing ? ", twiced" : "") << ")";
     if (s.msCacheGuide > 0) report << ", guided towards the lights (share " << s.msCacheGuide << ")";
+    if (s.msCacheBudgetMax > 0)
+      report << ", allocated perceptually (" << s.msCacheBudgetMin << "-" << s.msCacheBudgetMax << " paths a column)";
     report << " in " << s.msCacheMs << " ms (not in the frame times)\n";
   }
   report << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "

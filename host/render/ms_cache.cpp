@@ -1,17 +1,21 @@
 #include "render/ms_cache.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <vector>
 
 #include "render/device_allocation.h"
 #include "render/majorant_options.h"
 #include "render/node_grid.h"
 #include "render/render_common.h"
 #include "shared/ms_cache.h"
+#include "shared/ms_cache_view.h"
 
 namespace narval {
 
 void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params,
-                           int targetPaths, int pathsPerLaunch, const std::string& sceneFile) {
+                           int targetPaths, int pathsPerLaunch, const std::string& sceneFile,
+                           const MsCacheAllocation& allocation) {
   const node_grid_params& c = params.ms_cache;
   if (c.nx <= 0) throw std::invalid_argument("DeviceMsCache::refine: the cache is off (nx = 0)");
   const size_t nodes = nodeGridCount(c);
@@ -27,6 +31,11 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
                     std::to_string(params.ms_cache_tile) + (params.ms_cache_direct ? "/direct" : "") + "/guide" +
                     rawBytes(params.ms_cache_guide);
   const bool view = params.ms_cache_layout == MS_CACHE_LAYOUT_VIEW;
+  if (allocation.perceptual && !view)
+    throw std::invalid_argument("DeviceMsCache::refine: the perceptual allocation needs the view layout");
+  if (allocation.perceptual)
+    key += "/perceptual" + std::to_string(allocation.meanPaths) + "/" + toneMappingName(allocation.toneMapping) +
+           rawBytes(allocation.exposure);
   filterOn_ = view && params.ms_cache_filter > 0;
   twicingOn_ = filterOn_ && params.ms_cache_filter_twicing;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
@@ -43,9 +52,11 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
     kernel_ = NamedKernel(program_, "ms_cache_build");
     walkMajorants(rt, dev, pathScene);
     sceneBuf_ = constantBuffer(rt, pathScene);
+    sceneHost_ = pathScene;
     statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
     rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
-    paths_ = 0;
+    paths_ = budgetMin_ = budgetMax_ = 0;
+    allocation_ = allocation;
     ++rebuilds_;
     key_ = key;
     paramBuf_ = constantBuffer(rt, params);
@@ -61,8 +72,49 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
                                   deviceSceneBytes(dev.scene) + bytes_);
     }
   }
-  if (paths_ < targetPaths) addPaths(rt, dev, params, targetPaths, pathsPerLaunch);
+  const int launches = allocation_.perceptual ? allocatedLaunches(rt, params, targetPaths) : targetPaths;
+  if (paths_ < launches) addPaths(rt, dev, params, launches, pathsPerLaunch);
+  if (allocation_.perceptual && budgetMax_ == 0 && paths_ >= msAllocationPilot(allocation_.meanPaths) &&
+      targetPaths > paths_) {  // the pilot is done and more is asked: set the budgets, go on
+    addPaths(rt, dev, params, allocatedLaunches(rt, params, targetPaths), pathsPerLaunch);
+  }
   if (filterOn_) filter(rt, params);
+}
+
+int DeviceMsCache::paths() const {
+  if (!allocation_.perceptual || budgetMax_ == 0) return paths_;
+  if (paths_ >= budgetMax_) return allocation_.meanPaths;
+  // Between the pilot and the largest budget, pro rata: the caller's progress towards the mean.
+  const int pilot = msAllocationPilot(allocation_.meanPaths);
+  return pilot + int(int64_t(paths_ - pilot) * (allocation_.meanPaths - pilot) / (budgetMax_ - pilot));
+}
+
+int DeviceMsCache::allocatedLaunches(ClRuntime& rt, const realtime_params& params, int targetPaths) {
+  const int mean = allocation_.meanPaths, pilot = msAllocationPilot(mean);
+  if (targetPaths <= pilot || mean <= pilot) return std::min(targetPaths, std::max(pilot, mean));
+  if (paths_ < pilot) return pilot;  // the pilot first: the budgets come from it
+  if (budgetMax_ == 0) {
+    // The budgets (ms_cache_allocation.h), written into every node of their column (MS_VIEW_BUDGET).
+    const node_grid_params& c = params.ms_cache;
+    std::vector<float> nodes(bytes_ / sizeof(float));
+    rt.queue.enqueueReadBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
+    const medium_params& m = sceneHost_.medium;
+    const double ss = double(m.sigma_s.x) + m.sigma_s.y + m.sigma_s.z, sa = double(m.sigma_a.x) + m.sigma_a.y + m.sigma_a.z;
+    const std::vector<int> budgets =
+        msPerceptualBudgets(msColumnPilots(nodes, c, ss + sa > 0 ? ss / (ss + sa) : 0.0), c.nx, c.ny, allocation_);
+    const size_t columns = size_t(c.nx) * size_t(c.ny);
+    budgetMin_ = mean;
+    for (size_t col = 0; col < columns; ++col) {
+      if (budgets[col] <= 0) continue;
+      budgetMin_ = std::min(budgetMin_, budgets[col]);
+      budgetMax_ = std::max(budgetMax_, budgets[col]);
+      for (int s = 0; s < c.nz; ++s) nodes[(size_t(s) * columns + col) * MS_CACHE_STRIDE + MS_VIEW_BUDGET] = float(budgets[col]);
+    }
+    if (budgetMax_ == 0) budgetMin_ = budgetMax_ = mean;  // no column holds medium
+    rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
+  }
+  if (targetPaths >= mean) return budgetMax_;
+  return pilot + int((int64_t(targetPaths - pilot) * (budgetMax_ - pilot) + (mean - pilot) - 1) / (mean - pilot));
 }
 
 // The paths are the path tracer's, so they walk its majorant grid (majorant_options.h: 32 cells on

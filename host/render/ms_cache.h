@@ -10,6 +10,7 @@
 #include "cl/cl_runtime.h"
 #include "render/device_allocation.h"
 #include "render/device_scene.h"
+#include "render/ms_cache_allocation.h"
 #include "shared/structs.h"
 
 namespace narval {
@@ -20,14 +21,20 @@ class DeviceMsCache {
   // params.ms_cache (nx > 0), in launches of at most `pathsPerLaunch` paths per node; starts over
   // when the scene changed. Throws InputError when the cache exceeds the device's largest
   // allocation (naming `sceneFile` and renderer.raymarch.msCache.resolution).
+  // With allocation.perceptual (view layout; ms_cache_allocation.h) every node first takes the
+  // pilot, then each column its own budget, averaging allocation.meanPaths: `targetPaths` then
+  // counts towards that mean (paths() reaches it when every budget is spent).
   void refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params, int targetPaths,
-              int pathsPerLaunch, const std::string& sceneFile);
+              int pathsPerLaunch, const std::string& sceneFile, const MsCacheAllocation& allocation = {});
   // What the march reads: the running means, or with the view layout's filter on
   // (params.ms_cache_filter > 0; kernels/shared/ms_cache_filter.h) their filtered copy, twiced
   // when params.ms_cache_filter_twicing is set.
   const cl::Buffer& buffer() const { return twicingOn_ ? twiced_ : filterOn_ ? filtered_ : buffer_; }
   const cl::Buffer& means() const { return buffer_; }  // the running means, unfiltered
-  int paths() const { return paths_; }             // paths per node so far
+  int paths() const;                               // paths per node so far (allocated: their mean, pro rata)
+  // The perceptual allocation's smallest and largest budget (0, 0 before it is set or when off).
+  int budgetMin() const { return budgetMin_; }
+  int budgetMax() const { return budgetMax_; }
   int rebuilds() const { return rebuilds_; }       // times it started over (1 for one scene)
   double buildMs() const { return buildMs_; }      // launch time by profiling events, all launches
   size_t bytes() const { return bytes_; }
@@ -37,6 +44,9 @@ class DeviceMsCache {
   void addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params, int targetPaths,
                 int pathsPerLaunch);
   void filter(ClRuntime& rt, const realtime_params& params);
+  // The launch index the caller's `targetPaths` stands for under the allocation, setting the
+  // budgets once the pilot is done (ms_cache.cpp).
+  int allocatedLaunches(ClRuntime& rt, const realtime_params& params, int targetPaths);
   // The majorant grid the paths walk into pathScene and majorantBuf_ (ms_cache.cpp).
   void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);  // the filtered copy, when the paths or settings changed
 
@@ -51,7 +61,10 @@ class DeviceMsCache {
   cl::Buffer walkedBuf_;
   bool filterOn_ = false, twicingOn_ = false;
   std::string filteredKey_;  // the paths and filter settings the filtered copy was made from
-  int paths_ = 0, rebuilds_ = 0;
+  int paths_ = 0, rebuilds_ = 0;  // paths_: the launches' path index (every node's count, unless budgeted)
+  MsCacheAllocation allocation_;
+  scene_params sceneHost_{};  // the scene the paths see (its medium's albedo for the allocation)
+  int budgetMin_ = 0, budgetMax_ = 0;  // set: the budgets are in the nodes
   double buildMs_ = 0;
   size_t bytes_ = 0;
   uint32_t status_ = 0;

@@ -175,7 +175,13 @@ double RealtimeRenderer::renderFrame(bool progressiveCache, double* wallMs) {
   if (params_.ms_cache.nx > 0) {  // built to its paths (progressively: one launch a frame), then kept
     const MsCacheSettings& mc = view_.renderer.raymarch.msCache;
     const int target = progressiveCache ? std::min(mc.paths, msCache_.paths() + mc.pathsPerLaunch) : mc.paths;
-    msCache_.refine(rt_, dev_, params_, target, mc.pathsPerLaunch, view_.sourcePath);
+    MsCacheAllocation allocation;
+    allocation.perceptual =
+        mc.layout == MsCacheLayout::View && mc.allocation == MsCacheAllocationKind::Perceptual;
+    allocation.meanPaths = mc.paths;
+    allocation.toneMapping = view_.renderer.toneMapping;
+    allocation.exposure = view_.renderer.exposure;
+    msCache_.refine(rt_, dev_, params_, target, mc.pathsPerLaunch, view_.sourcePath, allocation);
     kernel_.set("ms_cache", msCache_.buffer());
   }
   const int W = view_.renderer.width, H = view_.renderer.height;
@@ -219,6 +225,8 @@ RenderResult RealtimeRenderer::result() {
     nodeGridCells(params_.ms_cache, st.msCacheCells);
   }
   st.msCacheGuide = params_.ms_cache_guide;
+  st.msCacheBudgetMin = msCache_.budgetMin();
+  st.msCacheBudgetMax = msCache_.budgetMax();
   result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
   return result;
 }

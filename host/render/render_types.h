@@ -106,6 +106,9 @@ struct RenderStats {
   bool msCacheFilterTwicing = false;
   // The share of the paths' first directions drawn towards the lights (kernels/shared/phase_guide.h).
   float msCacheGuide = 0;
+  // The view layout's perceptual allocation (render/ms_cache_allocation.h): its smallest and largest
+  // paths per column (0, 0: the even share).
+  int msCacheBudgetMin = 0, msCacheBudgetMax = 0;
 };
 
 struct RenderResult {

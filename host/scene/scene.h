@@ -109,6 +109,9 @@ enum class MsCacheInterpolation { Geometric, Linear };
 // Where its nodes are: a grid over the medium's box, or columns over the image with nodes along
 // each column's optical depth from the camera (kernels/shared/ms_cache_view.h).
 enum class MsCacheLayout { Grid, View };
+// How the view layout spreads its paths over its columns: the same number each, or by what their
+// noise costs the eye (host/render/ms_cache_allocation.h).
+enum class MsCacheAllocationKind { Even, Perceptual };
 
 struct MsCacheSettings {
   MsCacheClosure closure = MsCacheClosure::Linear;
@@ -128,7 +131,8 @@ struct MsCacheSettings {
   // closure "camera" or layout "view": the share of each path's first direction drawn about the
   // directions to the lights instead of by the phase function (kernels/shared/phase_guide.h); 0: none.
   float guide = 0;
-  int paths = 256;          // paths per node
+  MsCacheAllocationKind allocation = MsCacheAllocationKind::Even;  // view only
+  int paths = 256;          // paths per node (allocated: their mean over the nodes holding medium)
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
 };
 

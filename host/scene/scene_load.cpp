@@ -97,6 +97,8 @@
 // |                         | standard errors                 |     |             |                            |
 // |   raymarch.msCache.filterTwicing | boolean: the filter's  |     | false       | view; needs filter > 0     |
 // |                         | residual filtered, added back   |     |             |                            |
+// |   raymarch.msCache.allocation | even, perceptual: the   |     | even        | view                       |
+// |                         | paths per column (ms_cache_allocation.h) |  |          |                            |
 // |   raymarch.msCache.guide | number: share of the paths' first |   | 0 (off)     | [0, 1); closure camera or  |
 // |                         | directions drawn towards lights |     |             | layout view (phase_guide.h)|
 // |   raymarch.msCache.paths, .pathsPerLaunch | integer: per node |   | 256, 32     | [1, 2^20]                  |
@@ -204,6 +206,8 @@ const EnumNames<MsCacheInterpolation> kMsCacheInterpolations = {{"geometric", Ms
 const EnumNames<ShadowWeighting> kShadowWeightings = {{"area", ShadowWeighting::Area},
                                                       {"phase", ShadowWeighting::Phase}};
 const EnumNames<MsCacheLayout> kMsCacheLayouts = {{"grid", MsCacheLayout::Grid}, {"view", MsCacheLayout::View}};
+const EnumNames<MsCacheAllocationKind> kMsCacheAllocations = {{"even", MsCacheAllocationKind::Even},
+                                                              {"perceptual", MsCacheAllocationKind::Perceptual}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
 const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
                                           {"raymarch", Algorithm::Raymarch},
@@ -483,9 +487,9 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
         ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
       const bool view = s.raymarch.msCache.layout == MsCacheLayout::View;
       for (const std::string key :
-           {"resolution", "interpolation", "tile", "slices", "filter", "filterTolerance", "filterTwicing"})
+           {"resolution", "interpolation", "tile", "slices", "filter", "filterTolerance", "filterTwicing", "allocation"})
         if (mc.find(key) && view != (key == "tile" || key == "slices" || key == "filter" || key == "filterTolerance" ||
-                                     key == "filterTwicing"))
+                                     key == "filterTwicing" || key == "allocation"))
           ctx.warn(mc.keyOf(key), std::string("applies to layout \"") + (view ? "grid" : "view") + "\"; \"" +
                                       (view ? "view" : "grid") + "\" ignores it");
       s.raymarch.msCache.resolution = readInt(mc, "resolution", s.raymarch.msCache.resolution, 1, 256);
@@ -505,6 +509,7 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
       s.raymarch.msCache.filterTwicing = mc.getBool("filterTwicing", s.raymarch.msCache.filterTwicing);
       if (s.raymarch.msCache.filterTwicing && view && !(s.raymarch.msCache.filter > 0))
         ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
+      s.raymarch.msCache.allocation = readEnum(mc, "allocation", kMsCacheAllocations, s.raymarch.msCache.allocation);
       s.raymarch.msCache.guide = readNonNegative(mc, "guide", s.raymarch.msCache.guide);
       if (!(s.raymarch.msCache.guide < 1))
         ctx.fail(mc.keyOf("guide"), "must be below 1 (the phase function's share covers every direction), got " +

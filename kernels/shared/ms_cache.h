@@ -89,8 +89,9 @@
  * the default cloud 0.47e-3 → 0.42e-3 (bench/RESULTS.md).
  *
  * Storage: MS_CACHE_STRIDE floats per node: the running means of the paths so far, R (rgb) then
- * their count, then b for red, green and blue (xyz each, then a free float; the one after green's
- * holds the mean of the grey L², MS_CACHE_SQUARE, for the view filter's noise); then what the
+ * their count, then b for red, green and blue (xyz each, then a float: after red's the view layout's
+ * budget, after green's the mean of the grey L², MS_CACHE_SQUARE, for the view filter's noise, after
+ * blue's the view column's background, ms_cache_view.h); then what the
  * lookup reads, derived from them by the build after each launch: ln R (rgb, at MS_CACHE_LOG_R)
  * and b/R (at MS_CACHE_RATIO), so that a lookup takes no logarithm or division per corner (the
  * ray marcher makes one lookup per sample); each build launch

@@ -171,8 +171,8 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
 
 /* One launch's work for node `node` (ms_cache.cl): paths [first, first + count) at the node's point,
  * for the cache's layout. A grid node no lookup reads is left at 0 (ms_cache_node_is_read); a view
- * node's slice is where ms_view_place_column put it, and it takes no paths when its column holds no
- * medium. */
+ * node's slice is where ms_view_place_column put it, it takes no paths when its column holds no
+ * medium, and none past its budget when it has one (MS_VIEW_BUDGET). */
 static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
                                        NV_GLOBAL float* v, uint first, uint count) {
   NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
@@ -183,9 +183,17 @@ static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const r
                              affine_point(c->index_to_world, node_grid_point(c, vec3_from4(ctx->medium->dims), node)),
                              node, v, first, count);
       return;
-    case MS_CACHE_LAYOUT_VIEW: /* placed once per cache by ms_cache_place_view; each path draws its point */
-      if (v[MS_VIEW_TAU] >= 0.0f) ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp, vec3_splat(0.0f), node, v, first, count);
+    case MS_CACHE_LAYOUT_VIEW: { /* placed once per cache by ms_cache_place_view; each path draws its point */
+      if (!(v[MS_VIEW_TAU] >= 0.0f)) return;
+      /* A budget (the host's perceptual allocation) stops the node at its own number of paths. */
+      const uint budget = (uint)v[MS_VIEW_BUDGET];
+      if (budget > 0u) {
+        if (first >= budget) return;
+        count = budget - first < count ? budget - first : count;
+      }
+      ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp, vec3_splat(0.0f), node, v, first, count);
       return;
+    }
     default: return; /* unknown: reported at the kernel's entry */
   }
 }

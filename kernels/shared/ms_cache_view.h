@@ -54,6 +54,12 @@
 #define MS_VIEW_T 30
 #define MS_VIEW_TAU_END 31
 #define MS_VIEW_T_END 19
+/* The paths a node takes (ms_cache_build.h; 0: as many as each launch asks), written by the host's
+ * perceptual allocation (render/ms_cache_allocation.h); and on a column's slice 0, the background's
+ * light through the column's last level, T_end·grey(L_b) (T_end ≥ MS_VIEW_T_MIN), which that
+ * allocation weighs by. */
+#define MS_VIEW_BUDGET 7
+#define MS_VIEW_SEEN 15
 #define MS_VIEW_T_MIN 0.01f
 #define MS_VIEW_PLACE_STEPS 256
 #define MS_VIEW_SAMPLE_STEPS 16 /* a path's march across its slice to its drawn τ */
@@ -111,7 +117,7 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
   for (int slice = 0; slice < c->nz; ++slice) {
     NV_GLOBAL float* v = cache + (size_t)slice * slice_stride;
     v[MS_VIEW_TAU] = v[MS_VIEW_TAU_END] = -1.0f;
-    v[MS_VIEW_T] = v[MS_VIEW_T_END] = 0.0f;
+    v[MS_VIEW_T] = v[MS_VIEW_T_END] = v[MS_VIEW_BUDGET] = v[MS_VIEW_SEEN] = 0.0f;
   }
   medium_segment seg;
   if (!s->has_medium || !march_view_segment(s, ctx->lights, r.origin, r.dir, &seg)) return;
@@ -120,6 +126,7 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
   const float total = sigma * march_column_density(KERNEL_CONTEXT_ARG, r.origin, r.dir, seg.t1, MS_VIEW_PLACE_STEPS);
   if (!(total > 0.0f)) return;
   const float t_end = nv_fmax(nv_exp(-total), MS_VIEW_T_MIN);
+  cache[MS_VIEW_SEEN] = t_end * vec3_average(march_background(s, ctx->lights, r.origin, r.dir));
   /* Second march: where τ(t), linear over each step, reaches each level in turn; levels it does not
    * reach (rounding, or past τ_max) lie at the end of the last step with medium. */
   int i = 0;

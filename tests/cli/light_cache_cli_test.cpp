@@ -123,6 +123,22 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   EXPECT_EQ(stats("t.json")["nan_pixels"], 0);
   EXPECT_NE(r.out.find(", filtered (sigma 1.5 columns, tolerance 2 standard errors, twiced) in "), std::string::npos)
       << r.out;
+  // The perceptual allocation (render/ms_cache_allocation.h): a mean of 4 paths, a pilot of 1, the
+  // budgets within [0.625, 2.5] of the mean, reported in the line and the stats.
+  r = run("render s.json -o a.exr --stats-json a.json " + cache +
+          "--set renderer.raymarch.msCache.layout=\\\"view\\\" --set renderer.raymarch.msCache.allocation=\\\"perceptual\\\"");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const nlohmann::json budget = stats("a.json")["ms_cache_budget"];
+  ASSERT_EQ(budget.size(), 2u);
+  EXPECT_GE(budget[0].get<int>(), 3);
+  EXPECT_LE(budget[1].get<int>(), 10);
+  EXPECT_LE(budget[0].get<int>(), budget[1].get<int>());
+  EXPECT_EQ(stats("a.json")["ms_cache_paths"], 4);
+  EXPECT_NE(r.out.find("columns x rows x slices, a mean of 4 paths per node, filtered (sigma 1.5 columns, tolerance 2 "
+                       "standard errors), allocated perceptually ("),
+            std::string::npos)
+      << r.out;
   r = run("render s.json -o g.exr --stats-json g.json " + cache);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err,
@@ -244,6 +260,8 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "residual)\n"},
       {"renderer.raymarch.msCache.filterTwicing=1",
        "narval: s.json: renderer.raymarch.msCache.filterTwicing: expected a boolean, got number\n"},
+      {"renderer.raymarch.msCache.allocation=\\\"spread\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",
+       "narval: s.json: renderer.raymarch.msCache.allocation: unknown value \"spread\" (allowed: even, perceptual)\n"},
       {"renderer.raymarch.msCache.filter=\\\"wide\\\"",
        "narval: s.json: renderer.raymarch.msCache.filter: expected a number, got string\n"},
       {"renderer.raymarch.msCache.closure=\\\"hg\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",

@@ -46,8 +46,8 @@ inline RenderResult renderAlgorithm(const Scene& scene, SceneGrids grid = {}) {
 // lights and the HG closure; "raymarch+ms-cache-camera" the same cache with its paths aimed at the
 // camera; "raymarch+ms-cache-view" the view layout, columns of 2x2 pixels, 4 slices, with the
 // rectangles' shadows weighted by the phase; "raymarch+ms-cache-direct" the same holding the
-// lights' unscattered light too, no light loop) and the corrected Lobe Estimator (its phase exact
-// as well).
+// lights' unscattered light too, no light loop, its paths allocated perceptually over the columns)
+// and the corrected Lobe Estimator (its phase exact as well).
 inline const char* const kHardCaseRenderers[] = {"pathtrace",         "raymarch",
                                                  "raymarch+octaves",  "raymarch+ms-cache",
                                                  "raymarch+ms-cache-camera", "raymarch+ms-cache-view",
@@ -73,6 +73,7 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGr
       scene.renderer.raymarch.msCache.slices = 4;
       scene.renderer.raymarch.shadowWeighting = ShadowWeighting::Phase;
       scene.renderer.raymarch.msCache.direct = renderer == "raymarch+ms-cache-direct";
+      if (renderer == "raymarch+ms-cache-direct") scene.renderer.raymarch.msCache.allocation = MsCacheAllocationKind::Perceptual;
     }
   } else if (renderer == "raymarch+octaves") {
     scene.renderer.algorithm = Algorithm::Raymarch;
