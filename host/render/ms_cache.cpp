@@ -52,7 +52,10 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
     kernel_ = NamedKernel(program_, "ms_cache_build");
     walkMajorants(rt, dev, pathScene);
     sceneBuf_ = constantBuffer(rt, pathScene);
-    sceneHost_ = pathScene;
+    const medium_params& m = pathScene.medium;
+    const double ss = double(m.sigma_s.x) + m.sigma_s.y + m.sigma_s.z;
+    const double st = ss + double(m.sigma_a.x) + m.sigma_a.y + m.sigma_a.z;
+    albedo_ = st > 0 ? ss / st : 0.0;
     statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
     rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
     paths_ = budgetMin_ = budgetMax_ = 0;
@@ -98,10 +101,7 @@ int DeviceMsCache::allocatedLaunches(ClRuntime& rt, const realtime_params& param
     const node_grid_params& c = params.ms_cache;
     std::vector<float> nodes(bytes_ / sizeof(float));
     rt.queue.enqueueReadBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
-    const medium_params& m = sceneHost_.medium;
-    const double ss = double(m.sigma_s.x) + m.sigma_s.y + m.sigma_s.z, sa = double(m.sigma_a.x) + m.sigma_a.y + m.sigma_a.z;
-    const std::vector<int> budgets =
-        msPerceptualBudgets(msColumnPilots(nodes, c, ss + sa > 0 ? ss / (ss + sa) : 0.0), c.nx, c.ny, allocation_);
+    const std::vector<int> budgets = msPerceptualBudgets(msColumnPilots(nodes, c, albedo_), c.nx, c.ny, allocation_);
     const size_t columns = size_t(c.nx) * size_t(c.ny);
     budgetMin_ = mean;
     for (size_t col = 0; col < columns; ++col) {

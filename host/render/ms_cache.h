@@ -63,7 +63,7 @@ class DeviceMsCache {
   std::string filteredKey_;  // the paths and filter settings the filtered copy was made from
   int paths_ = 0, rebuilds_ = 0;  // paths_: the launches' path index (every node's count, unless budgeted)
   MsCacheAllocation allocation_;
-  scene_params sceneHost_{};  // the scene the paths see (its medium's albedo for the allocation)
+  double albedo_ = 0;  // the medium's grey albedo σs/σt (channel sums), which the allocation's Y takes
   int budgetMin_ = 0, budgetMax_ = 0;  // set: the budgets are in the nodes
   double buildMs_ = 0;
   size_t bytes_ = 0;

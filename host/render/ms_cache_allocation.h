@@ -3,10 +3,10 @@
 // (renderer.raymarch.msCache.allocation "perceptual").
 //
 // Why: on the back-lit Disney cloud every pixel the 8-bit judge fails lies in an opaque column, and
-// 83% of them where the reference's L* is 5–70: the bright rims of the cloud's dark body, where one
-// cache seed's L* differs from another's by 2.1–2.5 rms. The dark interior (L* < 5) differs by 0.5
-// and the white, saturated silhouettes by nothing (bench/RESULTS.md). An even share of paths spends
-// most of them where they change no pixel.
+// 83% of them where the reference's L* is 5–70: the bright rims of the cloud's dark body, where the
+// cache's noise is 2.1–2.5 L* rms (one seed against another, over √2); in the dark interior
+// (L* < 5) it is 0.5 and on the white, saturated silhouettes nothing (bench/RESULTS.md). An even
+// share of paths spends most of them where they change no pixel.
 //
 // What: after a pilot of every node (kPilotShare of the mean), column c's pixel is predicted as
 //   Y_c = Σ_s ΔT_s·a·J̄_s + e^{−τ_end}·L_b,
@@ -31,8 +31,8 @@
 namespace narval {
 
 // The pilot every node takes before the budgets are set, and the budgets' bounds, as shares of
-// the mean paths per node. Measured on the back-lit Disney cloud (tile 1, mean 136–152, σ_s 1.5,
-// k 2, twiced): floor at the pilot 5.03%, at 0.625 of the mean 4.68% (bench/RESULTS.md).
+// the mean paths per node. Measured on the back-lit Disney cloud (tile 1, a mean of 152, σ_s 1.5,
+// k 2, twiced, cap 2.5x): the floor at the pilot 4.90%, at 0.63 of the mean 4.68% (bench/RESULTS.md).
 constexpr double kMsAllocationPilotShare = 0.25;
 constexpr double kMsAllocationFloorShare = 0.625;
 constexpr double kMsAllocationCapShare = 2.5;
