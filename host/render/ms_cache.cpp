@@ -75,12 +75,14 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const r
                                   deviceSceneBytes(dev.scene) + bytes_);
     }
   }
-  const int launches = allocation_.perceptual ? allocatedLaunches(rt, params, targetPaths) : targetPaths;
-  if (paths_ < launches) addPaths(rt, dev, params, launches, pathsPerLaunch);
-  if (allocation_.perceptual && budgetMax_ == 0 && paths_ >= msAllocationPilot(allocation_.meanPaths) &&
-      targetPaths > paths_) {  // the pilot is done and more is asked: set the budgets, go on
-    addPaths(rt, dev, params, allocatedLaunches(rt, params, targetPaths), pathsPerLaunch);
+  int launches = targetPaths;
+  if (allocation_.perceptual) {  // the pilot first, then the budgets from it, then the launches they need
+    const int pilot = msAllocationPilot(allocation_.meanPaths);
+    if (paths_ < pilot) addPaths(rt, dev, params, std::min(targetPaths, pilot), pathsPerLaunch);
+    if (budgetMax_ == 0 && paths_ >= pilot && targetPaths > pilot) setBudgets(rt, params);
+    launches = budgetMax_ == 0 ? paths_ : allocatedLaunches(targetPaths);
   }
+  if (paths_ < launches) addPaths(rt, dev, params, launches, pathsPerLaunch);
   if (filterOn_) filter(rt, params);
 }
 
@@ -92,28 +94,31 @@ int DeviceMsCache::paths() const {
   return pilot + int(int64_t(paths_ - pilot) * (allocation_.meanPaths - pilot) / (budgetMax_ - pilot));
 }
 
-int DeviceMsCache::allocatedLaunches(ClRuntime& rt, const realtime_params& params, int targetPaths) {
-  const int mean = allocation_.meanPaths, pilot = msAllocationPilot(mean);
-  if (targetPaths <= pilot || mean <= pilot) return std::min(targetPaths, std::max(pilot, mean));
-  if (paths_ < pilot) return pilot;  // the pilot first: the budgets come from it
-  if (budgetMax_ == 0) {
-    // The budgets (ms_cache_allocation.h), written into every node of their column (MS_VIEW_BUDGET).
-    const node_grid_params& c = params.ms_cache;
-    std::vector<float> nodes(bytes_ / sizeof(float));
-    rt.queue.enqueueReadBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
-    const std::vector<int> budgets = msPerceptualBudgets(msColumnPilots(nodes, c, albedo_), c.nx, c.ny, allocation_);
-    const size_t columns = size_t(c.nx) * size_t(c.ny);
-    budgetMin_ = mean;
-    for (size_t col = 0; col < columns; ++col) {
-      if (budgets[col] <= 0) continue;
-      budgetMin_ = std::min(budgetMin_, budgets[col]);
-      budgetMax_ = std::max(budgetMax_, budgets[col]);
-      for (int s = 0; s < c.nz; ++s) nodes[(size_t(s) * columns + col) * MS_CACHE_STRIDE + MS_VIEW_BUDGET] = float(budgets[col]);
-    }
-    if (budgetMax_ == 0) budgetMin_ = budgetMax_ = mean;  // no column holds medium
-    rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
+// The budgets (ms_cache_allocation.h) from the pilot's means, written into every node of their
+// column (MS_VIEW_BUDGET): one read-back and one write of the whole cache, once per cache.
+void DeviceMsCache::setBudgets(ClRuntime& rt, const realtime_params& params) {
+  const node_grid_params& c = params.ms_cache;
+  std::vector<float> nodes(bytes_ / sizeof(float));
+  rt.queue.enqueueReadBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
+  const std::vector<int> budgets = msPerceptualBudgets(msColumnPilots(nodes, c, albedo_), c.nx, c.ny, allocation_);
+  const size_t columns = size_t(c.nx) * size_t(c.ny);
+  budgetMin_ = allocation_.meanPaths;
+  for (size_t col = 0; col < columns; ++col) {
+    if (budgets[col] <= 0) continue;
+    budgetMin_ = std::min(budgetMin_, budgets[col]);
+    budgetMax_ = std::max(budgetMax_, budgets[col]);
+    for (int s = 0; s < c.nz; ++s) nodes[(size_t(s) * columns + col) * MS_CACHE_STRIDE + MS_VIEW_BUDGET] = float(budgets[col]);
   }
+  if (budgetMax_ == 0) budgetMin_ = budgetMax_ = allocation_.meanPaths;  // no column holds medium
+  rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
+}
+
+// The launch index a target of `targetPaths` mean paths stands for once the budgets are set: the
+// largest budget at the mean, pro rata between the pilot and it (paths() is its inverse).
+int DeviceMsCache::allocatedLaunches(int targetPaths) const {
+  const int mean = allocation_.meanPaths, pilot = msAllocationPilot(mean);
   if (targetPaths >= mean) return budgetMax_;
+  if (targetPaths <= pilot) return targetPaths;
   return pilot + int((int64_t(targetPaths - pilot) * (budgetMax_ - pilot) + (mean - pilot) - 1) / (mean - pilot));
 }
 

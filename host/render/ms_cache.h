@@ -44,9 +44,10 @@ class DeviceMsCache {
   void addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const realtime_params& params, int targetPaths,
                 int pathsPerLaunch);
   void filter(ClRuntime& rt, const realtime_params& params);
-  // The launch index the caller's `targetPaths` stands for under the allocation, setting the
-  // budgets once the pilot is done (ms_cache.cpp).
-  int allocatedLaunches(ClRuntime& rt, const realtime_params& params, int targetPaths);
+  // The perceptual allocation (ms_cache.cpp): the budgets, once the pilot is done, and the launch
+  // index the caller's `targetPaths` stands for under them.
+  void setBudgets(ClRuntime& rt, const realtime_params& params);
+  int allocatedLaunches(int targetPaths) const;
   // The majorant grid the paths walk into pathScene and majorantBuf_ (ms_cache.cpp).
   void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);  // the filtered copy, when the paths or settings changed
 

@@ -17,10 +17,11 @@
 // value), so the expected (δL*)² after n_c paths is (L*'(Y_c)·σ_c)²/n_c; at a fixed total it is
 // least for n_c ∝ L*'(Y_c)·σ_c (a Lagrange multiplier), kept within [kFloorShare, kCapShare] of the
 // mean so that no column is left with the few paths whose skewed mean a denoiser then favours
-// (measured: a floor at the pilot darkened the rims by 1 L*). Both Y_c and σ_c are taken from the
-// column's eight neighbours, never its own pilot: its budget is then independent of its own paths,
-// so its mean stays unbiased (a node that drew a dim pilot must not be starved; bench/RESULTS.md,
-// the allocation by spread). The budgets average to the mean over the columns holding medium.
+// (measured: a floor at the pilot darkened the rims by 0.7–1 L*). Both Y_c and σ_c are taken from
+// the column's eight neighbours, not its own pilot: its budget is then independent of its own paths
+// (but for the common scale, and for a column with no neighbour in the medium), so its mean stays
+// unbiased (a node that drew a dim pilot must not be starved; bench/RESULTS.md, the allocation by
+// spread). The budgets average to the mean over the columns holding medium.
 #pragma once
 
 #include <vector>
@@ -60,9 +61,9 @@ struct MsColumnPilot {
 // MS_CACHE_STRIDE floats, as ms_cache_view.h lays them out), for a medium of grey albedo `albedo`.
 std::vector<MsColumnPilot> msColumnPilots(const std::vector<float>& cache, const node_grid_params& c, double albedo);
 
-// Each column's weight L*'(Y)·σ from its eight neighbours with medium (itself alone when it has
-// none; 0 without medium), for columns on an nx × ny image grid. A column's own pilot never enters
-// its own weight.
+// Each column's weight L*'(Y)·σ from its eight neighbours with medium (0 without medium), for
+// columns on an nx × ny image grid: a column's own pilot never enters its own weight, except for
+// a column none of whose neighbours holds medium, which has only its own to go by.
 std::vector<double> msPerceptualWeights(const std::vector<MsColumnPilot>& columns, int nx, int ny,
                                         const MsCacheAllocation& allocation);
 
