@@ -23,6 +23,17 @@ InputError unknownKind(const std::string& what, int kind) {
   return InputError("the kernels know no " + what + " kind " + std::to_string(kind));
 }
 
+// The id's own name (phase_kinds.h), as -DPHASE_FIXED takes it.
+std::string phaseKindId(int kind) {
+  switch (kind) {
+#define PHASE_KIND_NAME(id, value, name, prefix, key, lo, hi, fallback) \
+  case id: return #id;
+    PHASE_KINDS(PHASE_KIND_NAME)
+#undef PHASE_KIND_NAME
+  }
+  throw unknownKind("phase function", kind);
+}
+
 }  // namespace
 
 std::string sceneFeatureOptions(const DeviceScene& ds) {
@@ -33,11 +44,7 @@ std::string sceneFeatureOptions(const DeviceScene& ds) {
     o += d;
   };
   if (sp.has_medium) {
-    switch (sp.medium.phase) {
-      case PHASE_HG: add("-DPHASE_FIXED_HG"); break;
-      case PHASE_ISOTROPIC: add("-DPHASE_FIXED_ISOTROPIC"); break;
-      default: throw unknownKind("phase function", sp.medium.phase);
-    }
+    add(("-DPHASE_FIXED=" + phaseKindId(sp.medium.phase.kind)).c_str());
     add(sp.medium.grey ? "-DMEDIUM_GREY" : "-DMEDIUM_CHROMATIC");
     switch (sp.medium.emission.kind) {
       case EMISSION_NONE: break;

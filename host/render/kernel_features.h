@@ -6,7 +6,7 @@
 // (the program cache keys on the options, so each variant is built once):
 //
 //   -DMEDIUM_HOMOGENEOUS                         no grid: density 1 in the box      (grid.h)
-//   -DPHASE_FIXED_ISOTROPIC / -DPHASE_FIXED_HG  the medium's phase function      (phase.h)
+//   -DPHASE_FIXED=<id, e.g. PHASE_HG>            the medium's phase function      (phase.h)
 //   -DMEDIUM_GREY / -DMEDIUM_CHROMATIC           σ grey or not: analogue walk or
 //                                                spectral tracking only             (tracking.h)
 //   -DLIGHTS_POINT_ONLY / -DLIGHTS_RECT_ONLY     no rectangle light / only rectangles (intersect.h,

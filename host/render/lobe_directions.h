@@ -10,13 +10,12 @@
 
 namespace narval {
 
-// n unit directions (w = 0) drawn from HG(g) about +Z (g = 0: isotropic), stratified in the
-// cosine (one uniform per stratum [i/n, (i+1)/n)) with an independent uniform azimuth, from the
-// counter-based RNG keyed by `seed`: the same set for the same (n, g, seed) on every machine.
-std::vector<nv_float4> lobeDirections(int n, float g, uint32_t seed);
+// n unit directions (w = 0) drawn from the phase function about +Z, stratified in the cosine (one
+// uniform per stratum [i/n, (i+1)/n)) with an independent uniform azimuth, from the counter-based
+// RNG keyed by `seed`: the same set for the same (n, phase, seed) on every machine.
+std::vector<nv_float4> lobeDirections(int n, phase_params phase, uint32_t seed);
 
-// The directions for the medium of `sp` (scene as uploaded): its phase function's mean cosine
-// (phase_mean_cosine: g for HG, 0 isotropic), or isotropic without a medium.
+// The directions for the medium of `sp` (scene as uploaded), isotropic without a medium.
 std::vector<nv_float4> lobeDirections(int n, const scene_params& sp, uint32_t seed);
 
 }  // namespace narval

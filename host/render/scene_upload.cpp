@@ -15,6 +15,7 @@
 #include "render/kernel_features.h"
 #include "render/light_selection.h"
 #include "scene/input_error.h"
+#include "shared/phase.h"
 #include "volume/majorant_grid.h"
 
 namespace narval {
@@ -233,16 +234,7 @@ DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids) {
     const float D = m.density;
     med.sigma_a = f4(m.absorption[0] * D, m.absorption[1] * D, m.absorption[2] * D);
     med.sigma_s = f4(m.scattering[0] * D, m.scattering[1] * D, m.scattering[2] * D);
-    switch (m.phase) {
-      case PhaseFunction::HenyeyGreenstein:
-        med.phase = PHASE_HG;
-        med.g = m.g;
-        break;
-      case PhaseFunction::Isotropic:
-        med.phase = PHASE_ISOTROPIC;
-        med.g = 0.0f;
-        break;
-    }
+    med.phase = phase_make(m.phase, m.phaseParameter);
     med.grey = m.absorption[0] == m.absorption[1] && m.absorption[1] == m.absorption[2] &&
                m.scattering[0] == m.scattering[1] && m.scattering[1] == m.scattering[2];
     float maxSigmaT = 0.0f;

@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "shared/phase_kinds.h"
+
 namespace narval {
 
 using Vec3f = std::array<float, 3>;
@@ -21,7 +23,6 @@ struct Transform {
 };
 
 enum class MaterialType { Emitter, Volume };
-enum class PhaseFunction { Isotropic, HenyeyGreenstein };
 enum class GridSpace { Unit, File };
 
 // A volume's emission (pbrt-v4's model, kernels/shared/emission.h): the medium emits σa(x)·Le(x)
@@ -46,8 +47,8 @@ struct Material {
   // volume
   Vec3f scattering{0, 0, 0};
   Vec3f absorption{0, 0, 0};
-  PhaseFunction phase = PhaseFunction::Isotropic;
-  float g = 0.0f;
+  int phase = PHASE_ISOTROPIC;  // a phase_kinds.h id
+  float phaseParameter = 0.0f;  // the kind's one parameter (its registry key: HG's "g"), as loaded
   std::string path;          // resolved against the scene file's folder; empty: homogeneous
   std::string gridName = "density";
   float density = 1.0f;      // multiplier D

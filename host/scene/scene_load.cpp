@@ -137,6 +137,7 @@
 #include "scene/json_reader.h"
 #include "scene/scene.h"
 #include "scene/scene_path.h"
+#include "shared/phase.h"
 
 namespace narval {
 
@@ -179,8 +180,12 @@ E requireEnum(ObjectReader& r, const std::string& name, const EnumNames<E>& name
 
 const EnumNames<MaterialType> kMaterialTypes = {{"emitter", MaterialType::Emitter},
                                                 {"volume", MaterialType::Volume}};
-const EnumNames<PhaseFunction> kPhaseFunctions = {{"isotropic", PhaseFunction::Isotropic},
-                                                  {"hg", PhaseFunction::HenyeyGreenstein}};
+// The phase functions' names, from their list (phase_kinds.h).
+const EnumNames<int> kPhaseFunctions = {
+#define PHASE_KIND_NAME(id, value, name, prefix, key, lo, hi, fallback) {name, id},
+    PHASE_KINDS(PHASE_KIND_NAME)
+#undef PHASE_KIND_NAME
+};
 const EnumNames<GridSpace> kGridSpaces = {{"unit", GridSpace::Unit}, {"file", GridSpace::File}};
 const EnumNames<PrimitiveType> kPrimitiveTypes = {{"rectangle", PrimitiveType::Rectangle},
                                                   {"volume", PrimitiveType::Volume},
@@ -268,20 +273,46 @@ AreaLightPhase readAreaLightPhase(ObjectReader& r, AreaLightPhase fallback) {
 
 // --- sections ---
 
-void readHenyeyGreensteinG(ObjectReader& r, Material& m) {
-  const json* v = r.find("g");
-  if (!v) return;
-  const std::string key = r.keyOf("g");
-  m.g = toFloat(r.context(), *v, key);
-  if (!(std::fabs(m.g) <= 1)) r.context().fail(key, "must be in [-1, 1], got " + formatNumber(m.g));
-  if (std::fabs(m.g) == 1) {
-    // HG collapses to a delta there: sampling and evaluation would divide by zero.
-    m.g = std::copysign(0.9999f, m.g);
-    r.context().warn(key, "g = " + formatNumber(std::copysign(1.0f, m.g)) +
-                              " makes Henyey-Greenstein a delta function; clamped to " + formatNumber(m.g));
+// The phase function's own parameter (phase_kinds.h: each kind names its key, range and default):
+// read for the material's kind, range-checked, then as the kind uses it (phase_clamp: HG's ±1, a
+// delta function, is held just inside, with a warning). Another kind's key is said to be ignored.
+void readPhaseParameter(ObjectReader& r, Material& m) {
+  struct KindKey {
+    int id;
+    const char* name;
+    const char* key;
+    float lo, hi, fallback;
+  };
+  static const KindKey kKinds[] = {
+#define PHASE_KIND_KEY(id, value, name, prefix, key, lo, hi, fallback) {id, name, key, lo, hi, fallback},
+      PHASE_KINDS(PHASE_KIND_KEY)
+#undef PHASE_KIND_KEY
+  };
+  const char* ownName = "";
+  for (const KindKey& k : kKinds)
+    if (k.id == m.phase) ownName = k.name;
+  // Every kind's key is checked where it is given; another kind's, set away from its default, is
+  // named as ignored.
+  for (const KindKey& k : kKinds) {
+    if (!k.key) continue;
+    if (k.id == m.phase) m.phaseParameter = k.fallback;
+    const json* v = r.find(k.key);
+    if (!v) continue;
+    const std::string key = r.keyOf(k.key);
+    const float x = toFloat(r.context(), *v, key);
+    if (!(x >= k.lo && x <= k.hi))
+      r.context().fail(key, "must be in [" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "], got " + formatNumber(x));
+    if (k.id != m.phase) {
+      if (x != k.fallback)
+        r.context().warn(key, std::string("ignored by the ") + ownName + " phase function (use \"phaseFunction\": \"" +
+                                  k.name + "\")");
+      continue;
+    }
+    m.phaseParameter = phase_clamp(m.phase, x);
+    if (m.phaseParameter != x)
+      r.context().warn(key, std::string(k.key) + " = " + formatNumber(x) + " makes the " + k.name +
+                                " phase function degenerate; clamped to " + formatNumber(m.phaseParameter));
   }
-  if (m.phase == PhaseFunction::Isotropic && m.g != 0)
-    r.context().warn(key, "ignored by the isotropic phase function (use \"phaseFunction\": \"hg\")");
 }
 
 // The volume's `emission` object (scene.h Emission). `hasFile`: the volume reads a grid file, so
@@ -341,7 +372,7 @@ Material readMaterial(JsonContext& ctx, const json& value, const std::string& ke
     m.absorption = r.requireVec3("absorption");
     checkNonNegative(ctx, r.keyOf("absorption"), m.absorption);
     m.phase = readEnum(r, "phaseFunction", kPhaseFunctions, m.phase);
-    readHenyeyGreensteinG(r, m);
+    readPhaseParameter(r, m);
     if (const json* path = r.find("path"))
       m.path = resolveVolumePath(toString(ctx, *path, r.keyOf("path")), ctx.file, r.keyOf("path"));
     m.density = readNonNegative(r, "density", m.density);

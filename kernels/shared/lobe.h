@@ -185,12 +185,12 @@ static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
         vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, p, light_cache, k, P, to_light, dist, d));
     if (p->area_light_samples > 1 || p->area_light_phase != AREA_LIGHT_POINTS) {
       /* rectangles as K×K points or integrated exactly (march_light_phase) */
-      *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase(&lights[k], P, m->phase, m->g, d, p->area_light_phase,
+      *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase(&lights[k], P, m->phase, d, p->area_light_phase,
                                                                   p->area_light_samples)));
       continue;
     }
     /* w_in: the light's propagation direction, light → P. */
-    const float f = phase_eval(m->phase, m->g, vec3_scale(to_light, -1.0f), w_out);
+    const float f = phase_eval(m->phase, vec3_scale(to_light, -1.0f), w_out);
     if (!(f > 0.0f)) {
       if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
       continue;

@@ -255,7 +255,7 @@ static inline vec3 march_light_area_point(NV_CONSTANT const light_params* l, int
  * both phase and shadow, single scattering on the default cloud at g 0.8 sums to 0.68 of the path
  * tracer's (0.999 at g 0); 4x4 points for the phase bring it to 0.74, and the shadow averaged over
  * them as well (march_light_column, the callers' shadow) to 0.82. */
-static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3 x, int phase_kind, float g,
+static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                          vec3 view_dir, int K) {
   const vec3 Le = vec3_from4(l->radiance);
   switch (LIGHT_KIND(l)) {
@@ -263,7 +263,7 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
       const vec3 to = vec3_sub(vec3_from4(l->corner), x);
       const float d2 = vec3_dot(to, to);
       if (!(d2 > 0.0f)) return vec3_splat(0.0f);
-      return vec3_scale(Le, phase_eval(phase_kind, g, view_dir, vec3_scale(to, 1.0f / nv_sqrt(d2))) / d2);
+      return vec3_scale(Le, phase_eval(phase, view_dir, vec3_scale(to, 1.0f / nv_sqrt(d2))) / d2);
     }
     case LIGHT_RECTANGLE: break; /* below */
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
@@ -279,7 +279,7 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
       const vec3 dir = vec3_scale(to, 1.0f / nv_sqrt(d2));
       const float cos_l = -vec3_dot(dir, n);
       if (!(cos_l > 0.0f)) continue;
-      sum += cos_l * phase_eval(phase_kind, g, view_dir, dir) / d2;
+      sum += cos_l * phase_eval(phase, view_dir, dir) / d2;
     }
   return vec3_scale(Le, l->normal.w * inv_k * inv_k * sum);
 }
@@ -293,10 +293,10 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
  * cloud with the multiple-scattering cache: relMSE 1.88 against the path tracer with the centre,
  * 0.09 exact; bench/RESULTS.md); K×K points paint K² discs. A point light is itself, as in
  * march_light_phase_sum. */
-static inline vec3 march_light_phase_integral(NV_CONSTANT const light_params* l, vec3 x, int phase_kind, float g,
+static inline vec3 march_light_phase_integral(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                               vec3 view_dir) {
   switch (LIGHT_KIND(l)) {
-    case LIGHT_POINT: return march_light_phase_sum(l, x, phase_kind, g, view_dir, 1);
+    case LIGHT_POINT: return march_light_phase_sum(l, x, phase, view_dir, 1);
     case LIGHT_RECTANGLE: break; /* below */
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
   }
@@ -305,16 +305,16 @@ static inline vec3 march_light_phase_integral(NV_CONSTANT const light_params* l,
   if (!(vec3_dot(vec3_sub(x, c), vec3_from4(l->normal)) > 0.0f)) return vec3_splat(0.0f);
   const vec3 d0 = vec3_normalize(vec3_sub(c, x)), d1 = vec3_normalize(vec3_sub(vec3_add(c, u), x));
   const vec3 d2 = vec3_normalize(vec3_sub(vec3_add(vec3_add(c, u), v), x)), d3 = vec3_normalize(vec3_sub(vec3_add(c, v), x));
-  return vec3_scale(vec3_from4(l->radiance), phase_quad_integral(phase_kind, g, view_dir, d0, d1, d2, d3));
+  return vec3_scale(vec3_from4(l->radiance), phase_quad_integral(phase, view_dir, d0, d1, d2, d3));
 }
 
 /* The real-time kernels' phase over a light (realtime_params.area_light_phase): K×K points
  * (march_light_phase_sum) or the exact integral (march_light_phase_integral). */
-static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, int phase_kind, float g,
+static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                      vec3 view_dir, int area_light_phase, int K) {
   switch (area_light_phase) {
-    case AREA_LIGHT_POINTS: return march_light_phase_sum(l, x, phase_kind, g, view_dir, K);
-    case AREA_LIGHT_EXACT: return march_light_phase_integral(l, x, phase_kind, g, view_dir);
+    case AREA_LIGHT_POINTS: return march_light_phase_sum(l, x, phase, view_dir, K);
+    case AREA_LIGHT_EXACT: return march_light_phase_integral(l, x, phase, view_dir);
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
   }
 }
@@ -365,13 +365,13 @@ static inline float march_light_column_phase(KERNEL_CONTEXT_PARAM, NV_CONSTANT c
         } else { /* the phase's direction (i, j) */
           float pdf;
           int front = 0;
-          dir = phase_sample(m->phase, m->g, view_dir, ((float)i + 0.5f) / (float)K, ((float)j + 0.5f) / (float)K, &pdf);
+          dir = phase_sample(m->phase, view_dir, ((float)i + 0.5f) / (float)K, ((float)j + 0.5f) / (float)K, &pdf);
           d = intersect_rectangle(l, x, dir, 0.0f, &front);
           if (!(d < NV_INFINITY) || !front) continue;
         }
         const float cos_l = -vec3_dot(dir, nrm);
         if (!(cos_l > 0.0f)) continue;
-        const float p = phase_eval(m->phase, m->g, view_dir, dir);
+        const float p = phase_eval(m->phase, view_dir, dir);
         const float w = p / (n * d * d / (area * cos_l) + n * p);
         if (!(w > 0.0f)) continue;
         const float column = march_column_density(KERNEL_CONTEXT_ARG, x, dir, d, shadow_steps);

@@ -62,7 +62,7 @@ static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int clo
     case MS_CACHE_CLOSURE_LINEAR:
     case MS_CACHE_CLOSURE_HG: *pdf = 0.25f * NV_INV_PI; return sample_uniform_sphere(u1, u2);
     case MS_CACHE_CLOSURE_CAMERA:
-      return vec3_scale(phase_sample(s->medium.phase, s->medium.g, w_c, u1, u2, pdf), -1.0f);
+      return vec3_scale(phase_sample(s->medium.phase, w_c, u1, u2, pdf), -1.0f);
     default: *pdf = 0.0f; return sample_uniform_sphere(u1, u2); /* unknown: reported at the kernel's entry */
   }
 }
@@ -95,7 +95,7 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtim
     gd.share = rp->ms_cache_guide;
     gd.g = MS_CACHE_GUIDE_G;
     float f;
-    *omega = phase_guide_sample(ctx->lights, s->num_lights, s->medium.phase, s->medium.g, vec3_scale(w_c, -1.0f), gd,
+    *omega = phase_guide_sample(ctx->lights, s->num_lights, s->medium.phase, vec3_scale(w_c, -1.0f), gd,
                                 u[2], u[3], u[1], &f, &pdf);
     weight = pdf > 0.0f ? f / pdf : 0.0f;
   } else {

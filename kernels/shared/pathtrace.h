@@ -57,7 +57,7 @@ static inline vec3 pathtrace_light_at(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 
   const float prob = light_select_prob(s, lights, i);
   light_sample ls;
   if (!light_sample_point(&lights[i], x, u1, u2, &ls)) return vec3_splat(0.0f);
-  const float f = phase_eval(s->medium.phase, s->medium.g, w_in, ls.dir);
+  const float f = phase_eval(s->medium.phase, w_in, ls.dir);
   if (!(f > 0.0f)) {
     if (f != f) ctx->status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
     return vec3_splat(0.0f);
@@ -162,7 +162,7 @@ static inline vec3 pathtrace_radiance(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, int 
         L = vec3_add(L, vec3_mul(beta, pathtrace_direct(KERNEL_CONTEXT_ARG, x, d, &rng)));
         const float u1 = rng_uniform(&rng), u2 = rng_uniform(&rng);
         float pdf;
-        d = phase_sample(s->medium.phase, s->medium.g, d, u1, u2, &pdf);
+        d = phase_sample(s->medium.phase, d, u1, u2, &pdf);
         if (!(pdf > 0.0f)) { /* sampled a direction it gives no density (or NaN): unusable */
           *status |= STATUS_NEGATIVE_PDF;
           if (pdf != pdf) *status |= STATUS_NAN;

@@ -60,7 +60,7 @@ static inline float phase_guide_pdf(NV_CONSTANT const light_params* lights, int 
 /* Draws ω from the mixture with (u1, u2) (u1 picks the component and is stretched back to [0, 1),
  * so stratified numbers stay stratified within each) and u3 (the light, for the guide); writes the
  * phase value *f = p(w_in·ω) and the mixture's density *pdf. */
-static inline vec3 phase_guide_sample(NV_CONSTANT const light_params* lights, int num_lights, int kind, float g,
+static inline vec3 phase_guide_sample(NV_CONSTANT const light_params* lights, int num_lights, phase_params phase,
                                       vec3 w_in, phase_guide gd, float u1, float u2, float u3, NV_PRIVATE float* f,
                                       NV_PRIVATE float* pdf) {
   vec3 w;
@@ -69,10 +69,10 @@ static inline vec3 phase_guide_sample(NV_CONSTANT const light_params* lights, in
     const int k = (int)nv_fmin((float)(num_lights - 1), u3 * (float)num_lights);
     /* HG about a_k whatever the medium's phase kind (PHASE_KIND may fix it): phase_guide_lobes_pdf's */
     w = sample_direction_around(phase_guide_axis(&lights[k], gd.x), phase_hg_sample_cos(gd.g, u1 / gd.share), u2);
-    *f = phase_eval(kind, g, w_in, w);
+    *f = phase_eval(phase, w_in, w);
   } else {
     const float v1 = guided ? (u1 - gd.share) / (1.0f - gd.share) : u1;
-    w = phase_sample(kind, g, w_in, v1, u2, f);
+    w = phase_sample(phase, w_in, v1, u2, f);
   }
   *pdf = phase_guide_pdf(lights, num_lights, gd, *f, w);
   return w;

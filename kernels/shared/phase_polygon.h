@@ -32,21 +32,6 @@
 
 #include "shared/phase.h"
 
-/* G(μ)/(1 − μ²), what the contour integrand needs (below): (1 + g)/(2π·s·(s + 1 − g)·(1 + μ)) for
- * HG, 1/(4π(1 + μ)) isotropic; finite at the pole μ = 1 (p(1)/2), unbounded only at μ = −1. */
-static inline float phase_polygon_cap_over_sin2(int kind, float g, float mu) {
-  mu = nv_fmin(1.0f, nv_fmax(-1.0f, mu));
-  const float one_plus = nv_fmax(1.0f + mu, 1e-7f);
-  switch (PHASE_KIND(kind)) {
-    case PHASE_ISOTROPIC: return NV_INV_4PI / one_plus;
-    case PHASE_HG: {
-      const float s = nv_sqrt(phase_hg_denominator(g, mu));
-      return (1.0f + g) / (2.0f * NV_PI * s * (s + 1.0f - g) * one_plus);
-    }
-    default: return 0.0f; /* unknown: reported at the kernel's entry */
-  }
-}
-
 /* One edge's share of the contour integral, ∫ G dφ from unit direction v0 to unit direction v1.
  * Along the chord p(t) = (1 − t)·v0 + t·v1, ω = p/|p| and the azimuth about a turns at
  * dφ/dt = a·(ω × dω/dt)/(1 − μ²) = a·(v0 × v1)/(|p|²·(1 − μ²))   (p × p' = v0 × v1),
@@ -55,21 +40,21 @@ static inline float phase_polygon_cap_over_sin2(int kind, float g, float mu) {
  * 5 or more phase widths 1 − |g| (HG falls to half its peak within about 1 − |g| rad): one panel
  * for a light of 17° at g 0.8, four for Listing 4.1's 86° edges at g 0.9. n = v0 × v1, which the
  * caller has. */
-static inline float phase_polygon_edge(int kind, float g, vec3 a, vec3 v0, vec3 v1, vec3 n) {
+static inline float phase_polygon_edge(phase_params p, vec3 a, vec3 v0, vec3 v1, vec3 n) {
   const float node[4] = {0.06943184420297371f, 0.33000947820757187f, 0.6699905217924281f, 0.9305681557970263f};
   const float weight[4] = {0.17392742256872692f, 0.3260725774312731f, 0.3260725774312731f, 0.17392742256872692f};
   /* The chord |v1 − v0| ≤ the arc ≤ π/2 · the chord: a measure of the arc without trigonometry. */
   const float chord = vec3_length(vec3_sub(v1, v0));
-  const float width = PHASE_KIND(kind) == PHASE_HG ? 1.0f - nv_fabs(g) : 1.0f;
+  const float width = phase_width(p);
   const int panels = chord < 2.5f * width ? 1 : chord < 5.0f * width ? 2 : 4;
   const float inv = 1.0f / (float)panels;
   float sum = 0.0f;
   for (int q = 0; q < panels; ++q)
     for (int k = 0; k < 4; ++k) {
       const float t = ((float)q + node[k]) * inv;
-      const vec3 p = vec3_add(vec3_scale(v0, 1.0f - t), vec3_scale(v1, t));
-      const float p2 = vec3_dot(p, p);
-      sum += weight[k] * phase_polygon_cap_over_sin2(kind, g, vec3_dot(a, p) / nv_sqrt(p2)) / p2;
+      const vec3 c = vec3_add(vec3_scale(v0, 1.0f - t), vec3_scale(v1, t));
+      const float c2 = vec3_dot(c, c);
+      sum += weight[k] * phase_cap_over_sin2(p, vec3_dot(a, c) / nv_sqrt(c2)) / c2;
     }
   return vec3_dot(a, n) * sum * inv;
 }
@@ -77,21 +62,21 @@ static inline float phase_polygon_edge(int kind, float g, vec3 a, vec3 v0, vec3 
 /* P = ∫ p(a·ω) dω over the spherical quadrilateral with unit corner directions v0..v3 in order
  * (either winding; convex, as a rectangle seen from a point off its plane, which also keeps it in
  * an open hemisphere). When the corners' mean faces away from a, the integral is taken about −a
- * with −g (p_g(a·ω) = p_{−g}(−a·ω)), so that the quad never holds the axis's antipode, where the
+ * the phase mirrored (phase_scaled by −1: p'(a'·ω) = p(a·ω) for a' = −a), so that the quad never holds the axis's antipode, where the
  * integrand is unbounded; should it still (a quad nearly a hemisphere wide), 2π·G(−1) = 1 is added
  * back, the part of the region the contour does not see. Traversed the other way round, every
  * edge's share changes sign, so a clockwise quad takes the negated sum. */
-static inline float phase_quad_integral(int kind, float g, vec3 a, vec3 v0, vec3 v1, vec3 v2, vec3 v3) {
+static inline float phase_quad_integral(phase_params p, vec3 a, vec3 v0, vec3 v1, vec3 v2, vec3 v3) {
   const vec3 mean = vec3_add(vec3_add(v0, v1), vec3_add(v2, v3));
   if (vec3_dot(mean, a) < 0.0f) {
     a = vec3_scale(a, -1.0f);
-    g = -g;
+    p = phase_scaled(p, -1.0f);
   }
   const vec3 n0 = vec3_cross(v0, v1), n1 = vec3_cross(v1, v2), n2 = vec3_cross(v2, v3), n3 = vec3_cross(v3, v0);
   /* Counter-clockwise about the inside: the first edge's normal on the side of the mean. */
   const float sign = vec3_dot(n0, mean) < 0.0f ? -1.0f : 1.0f;
-  const float sum = phase_polygon_edge(kind, g, a, v0, v1, n0) + phase_polygon_edge(kind, g, a, v1, v2, n1) +
-                    phase_polygon_edge(kind, g, a, v2, v3, n2) + phase_polygon_edge(kind, g, a, v3, v0, n3);
+  const float sum = phase_polygon_edge(p, a, v0, v1, n0) + phase_polygon_edge(p, a, v1, v2, n1) +
+                    phase_polygon_edge(p, a, v2, v3, n2) + phase_polygon_edge(p, a, v3, v0, n3);
   const int holds_minus_a = sign * vec3_dot(a, n0) < 0.0f && sign * vec3_dot(a, n1) < 0.0f &&
                             sign * vec3_dot(a, n2) < 0.0f && sign * vec3_dot(a, n3) < 0.0f;
   return nv_fmax(0.0f, sign * sum + (holds_minus_a ? 1.0f : 0.0f));

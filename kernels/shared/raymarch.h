@@ -97,14 +97,14 @@ static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
     if (rp->area_light_samples > 1 || rp->area_light_phase != AREA_LIGHT_POINTS) {
       /* Rectangles as K×K points or integrated exactly (march_light_phase), one shadow for all. */
       const int K = rp->area_light_samples, mode = rp->area_light_phase;
-      vec3 lit = vec3_mul(vec3_exp_neg(tau), march_light_phase(&lights[l], x, m->phase, m->g, view_dir, mode, K));
+      vec3 lit = vec3_mul(vec3_exp_neg(tau), march_light_phase(&lights[l], x, m->phase, view_dir, mode, K));
       float ai = 1.0f, bi = 1.0f, ci = 1.0f;
       for (int i = 1; i < rp->octaves; ++i) {
         ai *= rp->octave_a;
         bi *= rp->octave_b;
         ci *= rp->octave_c;
         lit = vec3_add(lit, vec3_scale(vec3_mul(vec3_exp_neg(vec3_scale(tau, bi)),
-                                                march_light_phase(&lights[l], x, m->phase, m->g * ci, view_dir, mode, K)),
+                                                march_light_phase(&lights[l], x, phase_scaled(m->phase, ci), view_dir, mode, K)),
                                        ai));
       }
       sum = vec3_add(sum, lit);
@@ -112,14 +112,14 @@ static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
     }
     /* K = 1: the centre alone, the dissertation's point light, with its arithmetic. */
     /* Octave 0: plain single scattering. */
-    vec3 oct = vec3_scale(vec3_exp_neg(tau), phase_eval(m->phase, m->g, view_dir, dir));
+    vec3 oct = vec3_scale(vec3_exp_neg(tau), phase_eval(m->phase, view_dir, dir));
     if (rp->octaves > 1) {
       float ai = 1.0f, bi = 1.0f, ci = 1.0f;
       for (int i = 1; i < rp->octaves; ++i) {
         ai *= rp->octave_a;
         bi *= rp->octave_b;
         ci *= rp->octave_c;
-        const float p = phase_eval(m->phase, m->g * ci, view_dir, dir);
+        const float p = phase_eval(phase_scaled(m->phase, ci), view_dir, dir);
         oct = vec3_add(oct, vec3_scale(vec3_exp_neg(vec3_scale(tau, bi)), ai * p));
       }
     }
@@ -142,7 +142,7 @@ static inline vec3 raymarch_ms_cache(NV_CONSTANT const realtime_params* rp, NV_C
                                      float tau, float dtau, vec3 dir) {
   switch (rp->ms_cache_layout) {
     case MS_CACHE_LAYOUT_GRID:
-      return ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), p, phase_mean_cosine(m->phase, m->g),
+      return ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), p, phase_mean_cosine(m->phase),
                              rp->ms_cache_closure, rp->ms_cache_interpolation, vec3_scale(dir, -1.0f));
     case MS_CACHE_LAYOUT_VIEW: return ms_view_lookup(&rp->ms_cache, ms_cache, cols, tau, dtau);
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */

@@ -11,11 +11,7 @@
 static inline uint scene_kinds_status(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights) {
   uint status = 0u;
   if (s->has_medium) {
-    switch (s->medium.phase) {
-      case PHASE_ISOTROPIC:
-      case PHASE_HG: break;
-      default: status |= STATUS_UNKNOWN_KIND;
-    }
+    if (!phase_known(s->medium.phase.kind)) status |= STATUS_UNKNOWN_KIND;
     switch (s->medium.emission.kind) {
       case EMISSION_NONE: break;
       case EMISSION_COLOR:

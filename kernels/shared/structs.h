@@ -4,6 +4,7 @@
 #ifndef NARVAL_STRUCTS_H
 #define NARVAL_STRUCTS_H
 
+#include "shared/phase_kinds.h"
 #include "shared/vec3.h"
 
 /* Next-event estimation in the path tracer (scene_params.light_sampling; light_select.h). */
@@ -13,10 +14,6 @@
 /* Light types (light_params.type). */
 #define LIGHT_RECTANGLE 0
 #define LIGHT_POINT 1
-
-/* Phase function kinds (medium_params.phase). */
-#define PHASE_ISOTROPIC 0
-#define PHASE_HG 1
 
 /* Status word bits: kernels OR these into a global uint; the host reports them. */
 #define STATUS_NAN 1u
@@ -90,6 +87,16 @@ typedef struct emission_params {
   int pad0, pad1, pad2;
 } emission_params;
 
+/* A phase function: its kind (phase_kinds.h) and the kind's own constants (its header,
+ * phase_<kind>.h, says which; HG: coef.x = g). */
+typedef struct phase_params {
+  nv_float4 coef;
+  int kind;
+  int pad0;
+  int pad1;
+  int pad2;
+} phase_params;
+
 /* The participating medium: an axis-aligned box [0, dims] in grid index space (voxel i covers
  * [i, i+1], its centre at i + 0.5), reached from world space through one affine map. Coefficients
  * are per unit density and already include the material's density multiplier D. */
@@ -99,9 +106,10 @@ typedef struct medium_params {
   nv_float4 sigma_a;    /* absorption · D */
   nv_float4 sigma_s;    /* scattering · D */
   float majorant;       /* >= max over the box and channels of sigma_t(x) */
-  float g;              /* Henyey-Greenstein asymmetry */
-  int phase;            /* PHASE_ISOTROPIC or PHASE_HG */
   int grey;             /* 1: sigma_a and sigma_s are equal in all channels (analogue tracking) */
+  int pad0;
+  int pad1;
+  phase_params phase;
   majorant_grid_params majorant_grid; /* density bounds per cell: empty space is skipped */
   emission_params emission;
 } medium_params;

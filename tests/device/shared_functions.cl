@@ -44,7 +44,7 @@ __kernel void sf_phase_sample(__global const float* in, __global float* out, uin
   if (i >= n) return;
   __global const float* a = in + 6 * i;
   float pdf = 0.0f;
-  const vec3 w = phase_sample(PHASE_HG, a[0], vec3_make(a[1], a[2], a[3]), a[4], a[5], &pdf);
+  const vec3 w = phase_sample(phase_make(PHASE_HG, a[0]), vec3_make(a[1], a[2], a[3]), a[4], a[5], &pdf);
   out[4 * i + 0] = w.x;
   out[4 * i + 1] = w.y;
   out[4 * i + 2] = w.z;
@@ -143,10 +143,10 @@ __kernel void sf_scene_kinds(__constant scene_params* s, __constant light_params
   if (get_global_id(0) != 0 || n < 1u) return;
   const vec3 w = vec3_make(0.0f, 0.0f, 1.0f);
   float pdf = -1.0f;
-  phase_sample(s->medium.phase, s->medium.g, w, 0.25f, 0.5f, &pdf);
+  phase_sample(s->medium.phase, w, 0.25f, 0.5f, &pdf);
   light_sample ls;
   out[0] = scene_kinds_status(s, lights);
-  out[1] = as_uint(phase_eval(s->medium.phase, s->medium.g, w, w));
+  out[1] = as_uint(phase_eval(s->medium.phase, w, w));
   out[2] = as_uint(pdf);
   out[3] = (uint)light_sample_point(&lights[0], vec3_make(0.0f, 0.0f, 0.0f), 0.5f, 0.5f, &ls);
 }
@@ -159,6 +159,6 @@ __kernel void sf_realtime_kinds(__constant realtime_params* rp, __constant light
   if (get_global_id(0) != 0 || n < 1u) return;
   const vec3 w = vec3_make(0.0f, 0.0f, 1.0f);
   out[0] = realtime_kinds_status(rp);
-  out[1] = as_uint(march_light_phase(&lights[0], vec3_make(0.0f, 0.0f, 0.0f), PHASE_HG, 0.5f, w, rp->area_light_phase, 1).x);
+  out[1] = as_uint(march_light_phase(&lights[0], vec3_make(0.0f, 0.0f, 0.0f), phase_make(PHASE_HG, 0.5f), w, rp->area_light_phase, 1).x);
   out[2] = as_uint(ms_cache_closure(rp->ms_cache_closure, 2.0f, 0.8f, vec3_make(0.0f, 0.0f, 0.9f), w));
 }

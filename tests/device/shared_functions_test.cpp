@@ -213,7 +213,7 @@ TEST_F(SharedOnDevice, PhaseSample) {
   for (size_t i = 0; i < n; ++i) {
     const float* a = &in[6 * i];
     float p = 0.0f;
-    const vec3 w = phase_sample(PHASE_HG, a[0], vec3_make(a[1], a[2], a[3]), a[4], a[5], &p);
+    const vec3 w = phase_sample(phase_make(PHASE_HG, a[0]), vec3_make(a[1], a[2], a[3]), a[4], a[5], &p);
     // The direction is built from μ = phase_hg_sample_cos (above: within 1e-6 of the host's on
     // every device) and sin θ = sqrt(1 − μ²), whose slope |μ|/sin θ magnifies a difference δμ near
     // θ = 0 or π: |δw| ≤ δμ (1 + 1/sin θ). On PoCL this stays a few ulp; a GPU's pow/log (4 ulp
@@ -228,7 +228,7 @@ TEST_F(SharedOnDevice, PhaseSample) {
     // the host's phase_pdf of the device's own direction, which must agree to a few ulp.
     (void)p;
     const vec3 wDev = vec3_make(dev[4 * i], dev[4 * i + 1], dev[4 * i + 2]);
-    pdf.add(phase_pdf(PHASE_HG, a[0], vec3_make(a[1], a[2], a[3]), wDev), dev[4 * i + 3], 0.0f, at(i));
+    pdf.add(phase_pdf(phase_make(PHASE_HG, a[0]), vec3_make(a[1], a[2], a[3]), wDev), dev[4 * i + 3], 0.0f, at(i));
   }
   dir.report();
   pdf.report();
@@ -473,8 +473,7 @@ TEST_F(SharedOnDevice, TrackingDeltaChromaticHomogeneous) {
 TEST_F(SharedOnDevice, UnknownKindsSetTheStatusBitAndSendNothing) {
   scene_params s{};
   s.has_medium = 1;
-  s.medium.phase = PHASE_HG;
-  s.medium.g = 0.5f;
+  s.medium.phase = phase_make(PHASE_HG, 0.5f);
   s.num_lights = 2;
   std::vector<light_params> lights(2);
   lights[0].type = LIGHT_POINT;
@@ -494,17 +493,17 @@ TEST_F(SharedOnDevice, UnknownKindsSetTheStatusBitAndSendNothing) {
   EXPECT_NEAR(phase_hg_eval(0.5f, 1.0f), 0.75f / (4.0f * float(M_PI) * 0.125f), 1e-6f);
   float value;
   std::memcpy(&value, &out[1], sizeof value);
-  EXPECT_NEAR(value, phase_eval(PHASE_HG, 0.5f, w, w), 1e-6f);
+  EXPECT_NEAR(value, phase_eval(phase_make(PHASE_HG, 0.5f), w, w), 1e-6f);
   EXPECT_EQ(out[3], 1u);
 
-  s.medium.phase = 7;
+  s.medium.phase.kind = 7;
   out = probe();
   EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
   EXPECT_EQ(out[1], bits(0.0f));
   EXPECT_EQ(out[2], bits(0.0f));
   EXPECT_EQ(out[3], 1u);  // the light is still a known point light
 
-  s.medium.phase = PHASE_ISOTROPIC;
+  s.medium.phase = phase_make(PHASE_ISOTROPIC, 0.0f);
   lights[1].type = 5;  // the second light: the status says so, the first still lights
   out = probe();
   EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
@@ -516,14 +515,14 @@ TEST_F(SharedOnDevice, UnknownKindsSetTheStatusBitAndSendNothing) {
   EXPECT_EQ(out[3], 0u);  // an unknown light sends nothing
 
   s.has_medium = 0;  // without a medium the phase kind is not looked at
-  s.medium.phase = 7;
+  s.medium.phase.kind = 7;
   lights[0].type = lights[1].type = LIGHT_POINT;
   EXPECT_EQ(probe()[0], 0u);
 
   // Emission kinds: an unknown one, and an emitting medium reaching a kernel built without
   // -DEMISSION (this one), which could not show its light.
   s.has_medium = 1;
-  s.medium.phase = PHASE_ISOTROPIC;
+  s.medium.phase = phase_make(PHASE_ISOTROPIC, 0.0f);
   s.medium.emission.kind = 9;
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
   s.medium.emission.kind = EMISSION_COLOR;
@@ -558,7 +557,7 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
       rp.ms_cache_closure = closure;
       const std::vector<cl_uint> out = probe();
       EXPECT_EQ(out[0], 0u);
-      const float host = march_light_phase(&lights[0], vec3_make(0, 0, 0), PHASE_HG, 0.5f, w, phase, 1).x;
+      const float host = march_light_phase(&lights[0], vec3_make(0, 0, 0), phase_make(PHASE_HG, 0.5f), w, phase, 1).x;
       EXPECT_GT(host, 0.0f);
       EXPECT_NEAR(value(out[1]), host, 1e-5f * host) << "phase " << phase;
       const float closed = ms_cache_closure(closure, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w);

@@ -23,9 +23,12 @@
   F(light_params, pad0) F(light_params, pad1)                                                       \
   S(medium_params) F(medium_params, world_to_index) F(medium_params, world_to_index.row[2])        \
   F(medium_params, dims) F(medium_params, sigma_a) F(medium_params, sigma_s)                       \
-  F(medium_params, majorant) F(medium_params, g) F(medium_params, phase) F(medium_params, grey)    \
+  F(medium_params, majorant) F(medium_params, grey) F(medium_params, pad0) F(medium_params, pad1)  \
+  F(medium_params, phase) F(medium_params, phase.kind)                                             \
   F(medium_params, majorant_grid) F(medium_params, majorant_grid.cells_z)                         \
   F(medium_params, emission) F(medium_params, emission.kind)                                       \
+  S(phase_params) F(phase_params, coef) F(phase_params, kind) F(phase_params, pad0)                 \
+  F(phase_params, pad1) F(phase_params, pad2)                                                      \
   S(emission_params) F(emission_params, index_to_grid) F(emission_params, grid_dims)              \
   F(emission_params, color) F(emission_params, temperature_offset)                                \
   F(emission_params, temperature_scale) F(emission_params, table_max) F(emission_params, table_size)\

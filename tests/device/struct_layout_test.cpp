@@ -41,8 +41,8 @@ std::vector<LayoutValue> hostLayout() {
 
 // Sizes fixed by the field list in structs.h (4-byte scalars, nv_float4 = 16, no implicit padding):
 // camera 4·16 + 8·4 = 96, light 5·16 + 4·4 = 96, majorant grid 16 + 4·4 = 32,
-// emission 48 + 2·16 + 8·4 = 112, medium 48 + 3·16 + 4·4 + 32 + 112 = 256,
-// scene 96 + 256 + 16 + 8·4 = 400, node grid 48 + 4·4 = 64, realtime 12·4 + 2·64 + 16·4 = 240.
+// emission 48 + 2·16 + 8·4 = 112, phase 16 + 4·4 = 32, medium 48 + 3·16 + 4·4 + 32 + 32 + 112 = 288,
+// scene 96 + 288 + 16 + 8·4 = 432, node grid 48 + 4·4 = 64, realtime 12·4 + 2·64 + 16·4 = 240.
 // A change to a struct must be a deliberate change here too.
 TEST(StructLayoutHost, SizesAreMultiplesOf16) {
   int structs = 0;
@@ -51,7 +51,7 @@ TEST(StructLayoutHost, SizesAreMultiplesOf16) {
     ++structs;
     EXPECT_EQ(v.value % 16u, 0u) << v.what << " = " << v.value;
   }
-  EXPECT_EQ(structs, 10);  // nv_float4, nv_affine, camera, light, medium, emission, majorant grid, scene, node grid, realtime
+  EXPECT_EQ(structs, 11);  // nv_float4, nv_affine, camera, light, medium, phase, emission, majorant grid, scene, node grid, realtime
   EXPECT_EQ(sizeof(nv_float4), 16u);
   EXPECT_EQ(sizeof(nv_affine), 48u);
   EXPECT_EQ(sizeof(camera_params), 96u);
@@ -60,8 +60,9 @@ TEST(StructLayoutHost, SizesAreMultiplesOf16) {
   EXPECT_EQ(sizeof(realtime_params), 240u);
   EXPECT_EQ(sizeof(majorant_grid_params), 32u);
   EXPECT_EQ(sizeof(emission_params), 112u);
-  EXPECT_EQ(sizeof(medium_params), 256u);
-  EXPECT_EQ(sizeof(scene_params), 400u);
+  EXPECT_EQ(sizeof(phase_params), 32u);
+  EXPECT_EQ(sizeof(medium_params), 288u);
+  EXPECT_EQ(sizeof(scene_params), 432u);
 }
 
 TEST(StructLayoutOnDevice, MatchesTheHost) {

@@ -54,11 +54,12 @@ TEST(RenderAnalytic, AbsorptionOnlyBoxMatchesBeerLambert) {
 // is every pixel, bit for bit, wherever the camera looks (into the box or past it). The bounce cap
 // (1000) would darken a path only after 1000 real collisions: with optical thickness ≤ 6 the chance
 // of that is far below 1e-12.
-std::string furnaceScene(const std::string& volumeExtra, const std::string& scattering) {
+std::string furnaceScene(const std::string& volumeExtra, const std::string& scattering,
+                         const std::string& phase = R"("phaseFunction": "hg", "g": 0.6)") {
   return R"({
     "materials": [
       {"name": "white", "type": "volume", "scattering": )" + scattering + R"(, "absorption": [0, 0, 0],
-       "phaseFunction": "hg", "g": 0.6, "density": 3)" + volumeExtra + R"(}
+       )" + phase + R"(, "density": 3)" + volumeExtra + R"(}
     ],
     "primitives": [
       {"name": "box", "type": "volume", "transform": {"position": [0, 0, 0], "scale": [2, 1.5, 1], "rotation": [20, 30, 0]},

@@ -105,10 +105,10 @@ TEST(HardCasesNumeric, PhaseGOfPlusMinusOneIsClampedWithAWarningAndRendersFinite
         R"("scattering": [0.8, 0.8, 0.8], "absorption": [0.1, 0.1, 0.1], "phaseFunction": "hg", "g": )" + gs +
             R"(, "density": 2)",
         kPointLight + kRectBehind, "[0.1, 0.2, 0.3]", 20, kSmallRenderer));
-    EXPECT_EQ(scene.materials[1].g, sign * 0.9999f);
+    EXPECT_EQ(scene.materials[1].phaseParameter, sign * 0.9999f);
     EXPECT_EQ(scene.warnings, (std::vector<std::string>{
                                   "test_scene.json: materials[1].g: g = " + gs +
-                                  " makes Henyey-Greenstein a delta function; clamped to " +
+                                  " makes the hg phase function degenerate; clamped to " +
                                   (sign > 0 ? "0.9999" : "-0.9999")}));
     for (const char* alg : kAlgorithms) {
       const RenderResult r = renderWith(scene, alg);

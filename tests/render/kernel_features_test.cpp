@@ -74,23 +74,23 @@ TEST(KernelFeatures, OptionsDerivedFromTheScene) {
     std::string features, buildOptions;
   };
   const Case cases[] = {
-      {{"hg", false, true, true, true}, true, "-DPHASE_FIXED_HG -DMEDIUM_CHROMATIC",
-       "-DPHASE_FIXED_HG -DMEDIUM_CHROMATIC"},
+      {{"hg", false, true, true, true}, true, "-DPHASE_FIXED=PHASE_HG -DMEDIUM_CHROMATIC",
+       "-DPHASE_FIXED=PHASE_HG -DMEDIUM_CHROMATIC"},
       {{"isotropic", true, true, false, false}, true,
-       "-DPHASE_FIXED_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE",
-       "-DPHASE_FIXED_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE"},
-      {{"hg", true, false, true, false}, false, "-DPHASE_FIXED_HG -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE",
-       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED_HG -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE"},
+       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE",
+       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE"},
+      {{"hg", true, false, true, false}, false, "-DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE",
+       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE"},
       // No medium: no phase or σ feature.
       {{"hg", false, true, false, true, false}, false, "-DLIGHTS_RECT_ONLY", "-DMEDIUM_HOMOGENEOUS -DLIGHTS_RECT_ONLY"},
       // An emitting medium: its kernels carry emission (emission.h).
       {{"hg", true, true, false, false, true, true}, false,
-       "-DPHASE_FIXED_HG -DMEDIUM_GREY -DEMISSION -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE",
-       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED_HG -DMEDIUM_GREY -DEMISSION -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE"},
+       "-DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DEMISSION -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE",
+       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DEMISSION -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE"},
       // No light at all: nothing to intersect, as with point lights only.
       {{"isotropic", true, false, false, false}, true,
-       "-DPHASE_FIXED_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE",
-       "-DPHASE_FIXED_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE"},
+       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE",
+       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE"},
   };
   for (const Case& c : cases) {
     const std::string json = sceneJson(c.spec);
@@ -143,14 +143,14 @@ void expectSpecialisedEqualsGeneric(const SceneSpec& spec, const DenseGrid* grid
 // the scene's file). The loader never produces one: it means a host and kernels out of step.
 TEST(KernelFeatures, UnknownKindsAreAnErrorOnTheHost) {
   DeviceScene ds = buildDeviceScene(sceneFromJson(sceneJson({"hg", true, true, true, false})), nullptr);
-  ds.params.medium.phase = 7;
+  ds.params.medium.phase.kind = 7;
   try {
     sceneBuildOptions(ds);
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "the kernels know no phase function kind 7");
   }
-  ds.params.medium.phase = PHASE_HG;
+  ds.params.medium.phase.kind = PHASE_HG;
   ds.lights[0].type = 5;
   GenericKernels generic;
   try {

@@ -12,6 +12,7 @@
 #include "render/lobe_directions.h"
 #include "render/realtime_renderer.h"
 #include "render/scene_upload.h"
+#include "shared/phase.h"
 #include "render_fixture.h"
 #include "shared/lobe.h"
 #include "volume/grid.h"
@@ -161,11 +162,11 @@ void expectEquation7(const Scene& sceneIn, const BoxFrame& box, int* hits) {
   const D3 lo = scale(box.half, -1), hi = box.half;
   // Lengths inside the box, measured in its frame (a rotation keeps lengths).
   auto inside = [&](D3 a, D3 b) { return lengthInside(box.local(a), box.local(b), lo, hi); };
-  const double g = fog.g, radius = scene.renderer.lobe.lobeRadius, depthFactor = scene.renderer.lobe.depthFactor;
+  const double g = fog.phaseParameter, radius = scene.renderer.lobe.lobeRadius, depthFactor = scene.renderer.lobe.depthFactor;
   const D3 lightPos[2] = {d3(scene.primitives[0].transform.position), d3(scene.primitives[1].transform.position)};
   const D3 lightI[2] = {d3(scene.materials[0].albedo), d3(scene.materials[1].albedo)};
   const int n = scene.renderer.lobe.lobePoints;
-  const std::vector<nv_float4> dirs = lobeDirections(n, float(g), scene.renderer.seed);
+  const std::vector<nv_float4> dirs = lobeDirections(n, phase_make(fog.phase, float(g)), scene.renderer.seed);
 
   const realtime_params params = realtimeParams(scene, ds);
   const grid_view homogeneous{nullptr, 1, 1, 1};

@@ -27,11 +27,12 @@ namespace {
 // A white furnace: the unit cube of a purely scattering medium (albedo 1, isotropic), no lights,
 // background radiance 1. The radiance is 1 everywhere and in every direction.
 std::string furnaceJson(const std::string& multipleScattering, double density = 1,
-                        const std::string& layout = R"("layout": "grid", "resolution": 4)") {
+                        const std::string& layout = R"("layout": "grid", "resolution": 4)",
+                        const std::string& phase = "") {
   return R"({
     "materials": [
       {"name": "white", "type": "volume", "scattering": [1, 1, 1], "absorption": [0, 0, 0], "density": )" +
-         std::to_string(density) + R"(}
+         std::to_string(density) + phase + R"(}
     ],
     "primitives": [{"name": "box", "type": "volume", "transform": {"scale": [1, 1, 1]}, "materialName": "white"}],
     "camera": {"position": [0, 0, -3], "lookAt": [0, 0, 0], "vfov": 30},

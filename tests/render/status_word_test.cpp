@@ -190,7 +190,7 @@ TEST(StatusWord, PhaseFunctionDeltaIsANegativePdfForThePathTracer) {
                             "g": 0.5, "density": 1)",
                          true, "[0, 0, 0]");
   EXPECT_EQ(renderWith(scene, nullptr, "pathtrace").stats.status, 0u);
-  scene.materials[1].g = 1.0f;
+  scene.materials[1].phaseParameter = 1.0f;
   const RenderResult r = renderWith(scene, nullptr, "pathtrace");
   EXPECT_TRUE(r.stats.status & STATUS_NEGATIVE_PDF) << r.stats.status;
   EXPECT_EQ(r.stats.status & ~(STATUS_NEGATIVE_PDF | STATUS_NAN), 0u) << r.stats.status;

@@ -117,7 +117,7 @@ TEST(AreaLight, PhaseSumAndColumnConvergeToTheIntegralsOverTheLight) {
     uint status = 0;
     for (int K : {4, 16}) {
       const double tol = K == 16 ? 0.005 : 0.05;
-      const vec3 phase = march_light_phase_sum(&l, xf, m.phase, m.g, vf, K);
+      const vec3 phase = march_light_phase_sum(&l, xf, m.phase, vf, K);
       EXPECT_NEAR(phase.x, ref.phase, tol * ref.phase) << "K " << K;
       const float column =
           march_light_column(narval::test::hostContext(&m, &f.grid, &status), &l, xf, K, 8, SHADOW_WEIGHTING_AREA, vf);
@@ -127,7 +127,7 @@ TEST(AreaLight, PhaseSumAndColumnConvergeToTheIntegralsOverTheLight) {
     vec3 dir, I;
     float dist;
     ASSERT_TRUE(march_light_as_point(&l, xf, &dir, &dist, &I));
-    const vec3 centre = march_light_phase_sum(&l, xf, m.phase, m.g, vf, 1);
+    const vec3 centre = march_light_phase_sum(&l, xf, m.phase, vf, 1);
     const double point = I.x * hg(0.8, dot(kView, {dir.x, dir.y, dir.z})) / (double(dist) * dist);
     EXPECT_NEAR(centre.x, point, 1e-5 * point);
     const D3 c = {l.corner.x + 0.5 * (l.edge_u.x + l.edge_v.x), l.corner.y + 0.5 * (l.edge_u.y + l.edge_v.y),
@@ -158,8 +158,8 @@ TEST(AreaLight, PointLightIgnoresK) {
   const vec3 x = vec3_make(0.1f, -0.2f, 0.3f), view = vec3_make(0, 0, 1);
   uint status = 0;
   for (int K : {2, 7}) {
-    EXPECT_EQ(march_light_phase_sum(&ds.lights[0], x, ds.params.medium.phase, 0.5f, view, K).x,
-              march_light_phase_sum(&ds.lights[0], x, ds.params.medium.phase, 0.5f, view, 1).x);
+    EXPECT_EQ(march_light_phase_sum(&ds.lights[0], x, phase_make(ds.params.medium.phase.kind, 0.5f), view, K).x,
+              march_light_phase_sum(&ds.lights[0], x, phase_make(ds.params.medium.phase.kind, 0.5f), view, 1).x);
     EXPECT_EQ(march_light_column(narval::test::hostContext(&ds.params.medium, &grid, &status), &ds.lights[0], x, K, 8,
                                  SHADOW_WEIGHTING_AREA, view),
               march_light_column(narval::test::hostContext(&ds.params.medium, &grid, &status), &ds.lights[0], x, 1, 8,
@@ -199,7 +199,7 @@ TEST(AreaLight, PhaseWeightedColumnConvergesToThePhaseWeightedTransmittance) {
   }
   std::printf("[ area light ] phase-weighted against area-weighted column: up to %.0f%% apart\n", 100 * widest);
   EXPECT_GT(widest, 0.1);
-  m.phase = PHASE_ISOTROPIC;
+  m.phase = phase_make(PHASE_ISOTROPIC, 0.0f);
   const vec3 x = vec3_make(0.1f, -0.2f, 0.3f);
   const float area = march_light_column(narval::test::hostContext(&m, &f.grid, &status), &l, x, 8, 8,
                                         SHADOW_WEIGHTING_AREA, vf);

@@ -52,8 +52,8 @@ TEST(PhaseGuide, NoShareIsThePhaseFunctionBitForBit) {
   for (int i = 0; i < 2000; ++i) {
     const float u1 = u(rng), u2 = u(rng), u3 = u(rng);
     float f, pdf, expectedPdf;
-    const vec3 w = phase_guide_sample(lights.l, 2, PHASE_HG, kG, arrival(), guideOf(0.0f), u1, u2, u3, &f, &pdf);
-    const vec3 expected = phase_sample(PHASE_HG, kG, arrival(), u1, u2, &expectedPdf);
+    const vec3 w = phase_guide_sample(lights.l, 2, phase_make(PHASE_HG, kG), arrival(), guideOf(0.0f), u1, u2, u3, &f, &pdf);
+    const vec3 expected = phase_sample(phase_make(PHASE_HG, kG), arrival(), u1, u2, &expectedPdf);
     ASSERT_EQ(w.x, expected.x);
     ASSERT_EQ(w.y, expected.y);
     ASSERT_EQ(w.z, expected.z);
@@ -77,7 +77,7 @@ TEST(PhaseGuide, TheMixtureIntegratesToOne) {
       for (int j = 0; j < nphi; ++j) {
         const double phi = (j + 0.5) * 2.0 * kPi / nphi;
         const vec3 w = vec3_make(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z));
-        const float f = phase_eval(PHASE_HG, kG, arrival(), w);
+        const float f = phase_eval(phase_make(PHASE_HG, kG), arrival(), w);
         sum += phase_guide_pdf(lights.l, 2, gd, f, w);
       }
     }
@@ -103,10 +103,10 @@ TEST(PhaseGuide, WeightedSamplesEstimateThePhaseFunctionsMoments) {
     double s1 = 0, s1sq = 0, s2 = 0, s2sq = 0, unweighted = 0;
     for (int i = 0; i < n; ++i) {
       float f, pdf;
-      const vec3 w = phase_guide_sample(lights.l, 2, PHASE_HG, kG, arrival(), guideOf(share), u(rng), u(rng), u(rng),
+      const vec3 w = phase_guide_sample(lights.l, 2, phase_make(PHASE_HG, kG), arrival(), guideOf(share), u(rng), u(rng), u(rng),
                                         &f, &pdf);
       ASSERT_GT(pdf, 0.0f);
-      ASSERT_EQ(f, phase_eval(PHASE_HG, kG, arrival(), w));
+      ASSERT_EQ(f, phase_eval(phase_make(PHASE_HG, kG), arrival(), w));
       const double weight = double(f) / pdf, m = double(vec3_dot(w, a)) * vec3_dot(w, a);
       s1 += weight;
       s1sq += weight * weight;
@@ -139,7 +139,7 @@ TEST(PhaseGuide, TheGuideAimsAtTheLights) {
     const int n = 100000;
     for (int i = 0; i < n; ++i) {
       float f, pdf;
-      const vec3 w = phase_guide_sample(lights.l, 2, PHASE_HG, kG, arrival(), guideOf(share), u(rng), u(rng), u(rng),
+      const vec3 w = phase_guide_sample(lights.l, 2, phase_make(PHASE_HG, kG), arrival(), guideOf(share), u(rng), u(rng), u(rng),
                                         &f, &pdf);
       in += vec3_dot(w, a) > std::cos(kPi / 6);
     }

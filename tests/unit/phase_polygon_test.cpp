@@ -52,7 +52,7 @@ float contour(int kind, float g, vec3 x, vec3 a, const Rect& r) {
                      vec3_add(r.corner, r.v)};
   vec3 d[4];
   for (int i = 0; i < 4; ++i) d[i] = vec3_normalize(vec3_sub(p[i], x));
-  return phase_quad_integral(kind, g, vec3_normalize(a), d[0], d[1], d[2], d[3]);
+  return phase_quad_integral(phase_make(kind, g), vec3_normalize(a), d[0], d[1], d[2], d[3]);
 }
 
 struct Case {

@@ -81,10 +81,12 @@ vec3 normalized(double x, double y, double z) {
   return vec3_make(static_cast<float>(x / n), static_cast<float>(y / n), static_cast<float>(z / n));
 }
 
-// Histogram of N directions drawn by phase_sample(PHASE_HG, gSample, w_in) in (cos θ, φ) cells about
-// w_in, tested against the pdf of gPdf integrated over each cell. φ is measured in a frame built
-// here (not vec3_basis), so the test does not share the sampler's frame.
-ChiSquareResult phaseChiSquare(float gSample, float gPdf, int n, uint32_t seed) {
+// Histogram of N directions drawn by phase_sample(sampled, w_in) in (cos θ, φ) cells about w_in (μ
+// edges at edge(i/20), increasing from −1 to 1), tested against pdfMu (per steradian, a function of
+// μ) integrated over each cell. φ is measured in a frame built here (not vec3_basis), so the test
+// does not share the sampler's frame.
+ChiSquareResult phaseChiSquareOf(phase_params sampled, const std::function<double(double)>& pdfMu,
+                                 const std::function<double(double)>& edge, int n, uint32_t seed) {
   const int kMu = 20, kPhi = 40;
   const vec3 win = normalized(0.3, -0.5, 0.8);
   const double wx = win.x, wy = win.y, wz = win.z;
@@ -100,24 +102,31 @@ ChiSquareResult phaseChiSquare(float gSample, float gPdf, int n, uint32_t seed) 
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   for (int i = 0; i < n; ++i) {
     float pdf = 0.0f;
-    const vec3 v = phase_sample(PHASE_HG, gSample, win, uni(gen), uni(gen), &pdf);
+    const vec3 v = phase_sample(sampled, win, uni(gen), uni(gen), &pdf);
     const double mu = std::clamp(v.x * wx + v.y * wy + v.z * wz, -1.0, 1.0);
     double phi = std::atan2(v.x * bx + v.y * by + v.z * bz, v.x * tx + v.y * ty + v.z * tz);
     if (phi < 0.0) phi += 2.0 * kPi;
-    const int im = std::min(kMu - 1, static_cast<int>((mu + 1.0) * 0.5 * kMu));
+    int im = 0;
+    while (im < kMu - 1 && mu >= edge(double(im + 1) / kMu)) ++im;
     const int ip = std::min(kPhi - 1, static_cast<int>(phi / (2.0 * kPi) * kPhi));
     observed[im * kPhi + ip] += 1.0;
   }
   // Expected count of cell (μ-bin, φ-bin) = N · Δφ · ∫_bin p(μ) dμ (the pdf is per steradian and
-  // dω = dμ dφ). The integral is of phase_hg_eval itself, to 1e-9 of the bin mass.
+  // dω = dμ dφ). The integral is of the device's own eval, to 1e-9 of the bin mass.
   const double dphi = 2.0 * kPi / kPhi;
   for (int im = 0; im < kMu; ++im) {
-    const double a = -1.0 + 2.0 * im / kMu, b = -1.0 + 2.0 * (im + 1) / kMu;
-    const double mass = adaptiveSimpson(
-        [&](double mu) { return static_cast<double>(phase_hg_eval(gPdf, static_cast<float>(mu))); }, a, b, 1e-10);
+    const double a = edge(double(im) / kMu), b = edge(double(im + 1) / kMu);
+    const double mass = adaptiveSimpson(pdfMu, a, b, 1e-10);
     for (int ip = 0; ip < kPhi; ++ip) expected[im * kPhi + ip] = n * dphi * mass;
   }
   return chiSquare(observed, expected);
+}
+
+// HG: samples of gSample against the pdf of gPdf, in cells even in μ.
+ChiSquareResult phaseChiSquare(float gSample, float gPdf, int n, uint32_t seed) {
+  return phaseChiSquareOf(
+      phase_make(PHASE_HG, gSample), [&](double mu) { return double(phase_hg_eval(gPdf, float(mu))); },
+      [](double t) { return -1.0 + 2.0 * t; }, n, seed);
 }
 
 // ---- tests ----
@@ -191,11 +200,11 @@ TEST(PhaseHG, MatchesClosedForm) {
 TEST(PhaseIsotropic, EvalIsOneOverFourPi) {
   const float inv4pi = static_cast<float>(1.0 / (4.0 * kPi));
   const vec3 a = normalized(1, 2, 3), b = normalized(-3, 0.5, 1);
-  EXPECT_EQ(phase_eval(PHASE_ISOTROPIC, 0.7f, a, b), inv4pi);
-  EXPECT_EQ(phase_pdf(PHASE_ISOTROPIC, -0.7f, a, a), inv4pi);
+  EXPECT_EQ(phase_eval(phase_make(PHASE_ISOTROPIC, 0.7f), a, b), inv4pi);
+  EXPECT_EQ(phase_pdf(phase_make(PHASE_ISOTROPIC, -0.7f), a, a), inv4pi);
   for (float mu : {-1.0f, -0.3f, 0.0f, 0.6f, 1.0f}) EXPECT_EQ(phase_hg_eval(0.0f, mu), inv4pi);
   float pdf = -1.0f;
-  const vec3 v = phase_sample(PHASE_ISOTROPIC, 0.9f, a, 0.3f, 0.6f, &pdf);
+  const vec3 v = phase_sample(phase_make(PHASE_ISOTROPIC, 0.9f), a, 0.3f, 0.6f, &pdf);
   EXPECT_EQ(pdf, inv4pi);
   EXPECT_NEAR(vec3_length(v), 1.0f, 1e-6f);
 }
@@ -266,10 +275,10 @@ TEST(PhaseHG, SamplePdfMatchesEval) {
     for (const vec3& win : axes) {
       for (int i = 0; i < 20000; ++i) {
         float pdf = -1.0f;
-        const vec3 v = phase_sample(PHASE_HG, g, win, uni(gen), uni(gen), &pdf);
+        const vec3 v = phase_sample(phase_make(PHASE_HG, g), win, uni(gen), uni(gen), &pdf);
         ASSERT_NEAR(vec3_length(v), 1.0f, 2e-6f);
-        const float eval = phase_eval(PHASE_HG, g, win, v);
-        const float pp = phase_pdf(PHASE_HG, g, win, v);
+        const float eval = phase_eval(phase_make(PHASE_HG, g), win, v);
+        const float pp = phase_pdf(phase_make(PHASE_HG, g), win, v);
         ASSERT_GT(pdf, 0.0f);
         const double rel = std::fabs(double(pdf) - eval) / eval;
         worst = std::max(worst, rel);
@@ -296,12 +305,12 @@ TEST(PhaseHG, ExtremeGStaysFinite) {
       ASSERT_GE(mu, -1.0f);
       ASSERT_LE(mu, 1.0f);
       float pdf = -1.0f;
-      const vec3 v = phase_sample(PHASE_HG, g, win, u, 0.37f, &pdf);
+      const vec3 v = phase_sample(phase_make(PHASE_HG, g), win, u, 0.37f, &pdf);
       ASSERT_TRUE(vec3_is_finite(v)) << "g = " << g << ", u = " << u;
       ASSERT_NEAR(vec3_length(v), 1.0f, 2e-6f);
       ASSERT_TRUE(std::isfinite(pdf)) << "g = " << g << ", u = " << u;
       ASSERT_GT(pdf, 0.0f) << "g = " << g << ", u = " << u;
-      ASSERT_TRUE(std::isfinite(phase_eval(PHASE_HG, g, win, v)));
+      ASSERT_TRUE(std::isfinite(phase_eval(phase_make(PHASE_HG, g), win, v)));
     }
   }
   // For g = 0.999999 the median sample is essentially straight ahead: μ(0.5) = 1 − O(1e-12).

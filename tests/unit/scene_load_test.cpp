@@ -98,8 +98,8 @@ TEST_F(SceneFiles, Listing41LoadsAsPrinted) {
   EXPECT_EQ(v.type, MaterialType::Volume);
   EXPECT_EQ(v.scattering, (Vec3f{1.1f, 1.1f, 1.1f}));
   EXPECT_EQ(v.absorption, (Vec3f{0.01f, 0.01f, 0.01f}));
-  EXPECT_EQ(v.phase, PhaseFunction::HenyeyGreenstein);
-  EXPECT_EQ(v.g, 0.9f);
+  EXPECT_EQ(v.phase, PHASE_HG);
+  EXPECT_EQ(v.phaseParameter, 0.9f);
   EXPECT_EQ(v.path, vdb);  // relative to the scene file, absolute afterwards
   EXPECT_EQ(v.density, 10.0f);
   EXPECT_EQ(v.gridName, "density");
@@ -149,8 +149,8 @@ TEST(SceneDefaults, OptionalKeysTakeTheDocumentedDefaults) {
   const Scene s = parseScene(minimalScene().dump(), "s.json");
   EXPECT_TRUE(s.warnings.empty());
   const Material& fog = s.materials[1];
-  EXPECT_EQ(fog.phase, PhaseFunction::Isotropic);
-  EXPECT_EQ(fog.g, 0.0f);
+  EXPECT_EQ(fog.phase, PHASE_ISOTROPIC);
+  EXPECT_EQ(fog.phaseParameter, 0.0f);
   EXPECT_EQ(fog.path, "");  // homogeneous
   EXPECT_EQ(fog.gridName, "density");
   EXPECT_EQ(fog.density, 1.0f);
@@ -201,8 +201,8 @@ TEST(SceneDefaults, ExtensionsAreRead) {
   const Scene s = parseScene(j.dump(), "s.json");
   // Read all the same; the medium has no "path", which the two grid keys are told about.
   EXPECT_EQ(s.warnings.size(), 2u);
-  EXPECT_EQ(s.materials[1].phase, PhaseFunction::HenyeyGreenstein);
-  EXPECT_EQ(s.materials[1].g, -0.3f);
+  EXPECT_EQ(s.materials[1].phase, PHASE_HG);
+  EXPECT_EQ(s.materials[1].phaseParameter, -0.3f);
   EXPECT_EQ(s.materials[1].gridName, "smoke");
   EXPECT_EQ(s.materials[1].gridSpace, GridSpace::File);
   EXPECT_EQ(s.materials[1].density, 0.0f);
@@ -447,15 +447,15 @@ TEST(SceneWarnings, HenyeyGreensteinAtPlusMinusOneIsClamped) {
   j["materials"][1]["phaseFunction"] = "hg";
   j["materials"][1]["g"] = 1;
   Scene s = parseScene(j.dump(), "s.json");
-  EXPECT_EQ(s.materials[1].g, 0.9999f);
+  EXPECT_EQ(s.materials[1].phaseParameter, 0.9999f);
   EXPECT_EQ(s.warnings, (std::vector<std::string>{
-                            "s.json: materials[1].g: g = 1 makes Henyey-Greenstein a delta function; "
+                            "s.json: materials[1].g: g = 1 makes the hg phase function degenerate; "
                             "clamped to 0.9999"}));
   j["materials"][1]["g"] = -1.0;
   s = parseScene(j.dump(), "s.json");
-  EXPECT_EQ(s.materials[1].g, -0.9999f);
+  EXPECT_EQ(s.materials[1].phaseParameter, -0.9999f);
   EXPECT_EQ(s.warnings, (std::vector<std::string>{
-                            "s.json: materials[1].g: g = -1 makes Henyey-Greenstein a delta function; "
+                            "s.json: materials[1].g: g = -1 makes the hg phase function degenerate; "
                             "clamped to -0.9999"}));
 }
 
@@ -463,7 +463,7 @@ TEST(SceneWarnings, GWithIsotropicPhaseIsIgnored) {
   json j = minimalScene();
   j["materials"][1]["g"] = 0.5;
   const Scene s = parseScene(j.dump(), "s.json");
-  EXPECT_EQ(s.materials[1].phase, PhaseFunction::Isotropic);
+  EXPECT_EQ(s.materials[1].phase, PHASE_ISOTROPIC);
   EXPECT_EQ(s.warnings, (std::vector<std::string>{
                             "s.json: materials[1].g: ignored by the isotropic phase function "
                             "(use \"phaseFunction\": \"hg\")"}));
@@ -509,7 +509,7 @@ TEST(SceneOverrides, ReplaceCreateAndParseValues) {
                               "camera.position.2=-9", "renderer.spp=32", "renderer.storage=buffer"});
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(s.renderer.spp, 32);  // later overrides win
-  EXPECT_EQ(s.materials[1].g, 0.9f);
+  EXPECT_EQ(s.materials[1].phaseParameter, 0.9f);
   EXPECT_EQ(s.background, (Vec3f{1, 1, 1}));
   EXPECT_EQ(s.renderer.seed, 3u);
   EXPECT_EQ(s.renderer.lobe.lobePoints, 10);
@@ -638,7 +638,7 @@ TEST_F(SceneFiles, ShippedScenesParse) {
   const Scene cloud = parseScene(readFile(scenes / "cloud.json"), scenePath());
   EXPECT_TRUE(cloud.warnings.empty());
   EXPECT_EQ(cloud.materials[1].path, cloud128);
-  EXPECT_EQ(cloud.materials[1].g, 0.8f);
+  EXPECT_EQ(cloud.materials[1].phaseParameter, 0.8f);
   EXPECT_EQ(cloud.materials[1].density, 5.0f);
   EXPECT_EQ(cloud.primitives[1].transform.scale, (Vec3f{10, 10, 10}));
   EXPECT_EQ(cloud.renderer.width, 640);

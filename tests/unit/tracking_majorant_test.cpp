@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "shared/medium.h"
+#include "shared/phase.h"
 #include "shared/tracking.h"
 #include "unit/stat_util.h"
 #include "volume/grid.h"
@@ -46,7 +47,7 @@ medium_params handMedium(int nx, int ny, int nz) {
   m.sigma_s = {1, 1, 1, 0};
   m.majorant = 10.0f;
   m.grey = 1;
-  m.phase = PHASE_ISOTROPIC;
+  m.phase = phase_make(PHASE_ISOTROPIC, 0.0f);
   m.majorant_grid.cell_size = {1, 1, 1, 0};
   m.majorant_grid.cells_x = nx;
   m.majorant_grid.cells_y = ny;
@@ -170,7 +171,7 @@ EmptySpaceGrid makeEmptySpaceGrid(nv_float4 sigmaA, nv_float4 sigmaS, int grey) 
   for (float s : {sigmaA.x + sigmaS.x, sigmaA.y + sigmaS.y, sigmaA.z + sigmaS.z}) stMax = std::max(stMax, s);
   m.majorant = stMax * d.maxValue * (1.0f + 1e-5f);  // as scene_upload.cpp
   m.grey = grey;
-  m.phase = PHASE_ISOTROPIC;
+  m.phase = phase_make(PHASE_ISOTROPIC, 0.0f);
   m.majorant_grid = g.cells.params();
   return g;
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "shared/medium.h"
+#include "shared/phase.h"
 #include "shared/tracking.h"
 #include "unit/stat_util.h"
 #include "unit/host_context.h"
@@ -30,8 +31,7 @@ medium_params makeMedium(nv_float4 sigmaA, nv_float4 sigmaS, float majorant, int
   m.sigma_a = sigmaA;
   m.sigma_s = sigmaS;
   m.majorant = majorant;
-  m.g = 0.0f;
-  m.phase = PHASE_ISOTROPIC;
+  m.phase = phase_make(PHASE_ISOTROPIC, 0.0f);
   m.grey = grey;
   return m;
 }
