@@ -12,6 +12,7 @@
 
 #include "shared/phase_hg.h"
 #include "shared/phase_isotropic.h"
+#include "shared/phase_mie.h"
 #include "shared/sampling.h"
 
 #ifdef PHASE_FIXED

@@ -9,7 +9,8 @@
 
 #define PHASE_KINDS(X)                                            \
   X(PHASE_ISOTROPIC, 0, "isotropic", isotropic, 0, 0.0f, 0.0f, 0.0f) \
-  X(PHASE_HG, 1, "hg", hg, "g", -1.0f, 1.0f, 0.0f)
+  X(PHASE_HG, 1, "hg", hg, "g", -1.0f, 1.0f, 0.0f)                 \
+  X(PHASE_MIE, 2, "mie", mie, "dropletDiameter", 0.1f, 50.0f, 20.0f)
 
 #define PHASE_KIND_ID(id, value, name, prefix, key, lo, hi, fallback) id = value,
 enum phase_kind { PHASE_KINDS(PHASE_KIND_ID) };

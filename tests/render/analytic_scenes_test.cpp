@@ -83,6 +83,21 @@ TEST(RenderAnalytic, WhiteFurnaceHomogeneousIsExactlyOne) {
   EXPECT_EQ(r.stats.status, 0u);
 }
 
+// Mie (phase_mie.h) samples its blend exactly, so the walk's throughput stays 1 as with HG: in each
+// of the fit's three diameter ranges, and on a grid as well.
+TEST(RenderAnalytic, WhiteFurnaceWithMiePhaseIsExactlyOne) {
+  const DenseGrid cloud = makeCloud(32, 7);
+  for (const char* diameter : {"0.3", "2", "20"}) {
+    SCOPED_TRACE(std::string("dropletDiameter ") + diameter);
+    const std::string phase = std::string(R"("phaseFunction": "mie", "dropletDiameter": )") + diameter;
+    const RenderResult r = render(sceneFromJson(furnaceScene("", "[1, 1, 1]", phase)));
+    expectAllExactlyOne(r.image);
+    EXPECT_EQ(r.stats.status, 0u);
+  }
+  const RenderResult r = render(sceneFromJson(furnaceScene("", "[1, 1, 1]", R"("phaseFunction": "mie")")), &cloud);
+  expectAllExactlyOne(r.image);
+}
+
 // On grids, in every grid storage (renderer.storage: image, buffer, bricks): the walk's decisions
 // depend on the density, the throughput never does, so the image filter's rounding cannot move a
 // pixel off 1, nor can the bricks' empty space.

@@ -99,6 +99,27 @@ TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
   }
 }
 
+// The same furnace with Mie phase functions (phase_mie.h) from two of the fit's ranges: the cache's
+// paths sample the blend exactly (weight eval/pdf = 1), so every node again holds exactly 1 and the
+// march's telescoping sum reads 1 to the same 1e-5, in both layouts. The grid layout answers for
+// the camera's direction by its closure "camera" (paths drawn from the phase function about it);
+// the default closure rebuilds the direction from uniformly drawn paths' moments, whose noise an
+// anisotropic phase function does not cancel.
+TEST(MsCache, WhiteFurnaceIsOneWithMiePhaseFunctions) {
+  for (const char* diameter : {"0.5", "20"}) {
+    const std::string phase = std::string(R"(, "phaseFunction": "mie", "dropletDiameter": )") + diameter;
+    for (const std::string layout :
+         {R"("layout": "grid", "resolution": 4, "closure": "camera")", R"("layout": "view", "tile": 4)"}) {
+      SCOPED_TRACE(std::string("d = ") + diameter + ", " + layout);
+      const RenderResult r = renderRealtime(runtime(), sceneFromJson(furnaceJson("cache", 3, layout, phase)), nullptr, 1, {});
+      ASSERT_EQ(r.stats.status, 0u);
+      double worst = 0;
+      for (float v : r.image.rgb) worst = std::max(worst, std::fabs(v - 1.0));
+      EXPECT_LE(worst, 1e-5);
+    }
+  }
+}
+
 // A lit isotropic box (a point light above it, background 0.2): the cache's nodes after K paths.
 Scene litBox() {
   return sceneFromJson(R"({

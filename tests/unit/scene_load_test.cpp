@@ -322,7 +322,7 @@ TEST(SceneErrors, BadValuesNameFileKeyAndProblem) {
       {"/materials/1/density", 1e39, "s.json: materials[1].density: must be finite as a 32-bit float, got 1e+39"},
       // unknown enum values
       {"/materials/0/type", "light", "s.json: materials[0].type: unknown value \"light\" (allowed: emitter, volume)"},
-      {"/materials/1/phaseFunction", "rayleigh", "s.json: materials[1].phaseFunction: unknown value \"rayleigh\" (allowed: isotropic, hg)"},
+      {"/materials/1/phaseFunction", "rayleigh", "s.json: materials[1].phaseFunction: unknown value \"rayleigh\" (allowed: isotropic, hg, mie)"},
       {"/materials/1/gridSpace", "world", "s.json: materials[1].gridSpace: unknown value \"world\" (allowed: unit, file)"},
       {"/primitives/1/type", "sphere", "s.json: primitives[1].type: unknown value \"sphere\" (allowed: rectangle, volume, point)"},
       {"/renderer/algorithm", "mlt", "s.json: renderer.algorithm: unknown value \"mlt\" (allowed: pathtrace, raymarch, lobe)"},
@@ -467,6 +467,34 @@ TEST(SceneWarnings, GWithIsotropicPhaseIsIgnored) {
   EXPECT_EQ(s.warnings, (std::vector<std::string>{
                             "s.json: materials[1].g: ignored by the isotropic phase function "
                             "(use \"phaseFunction\": \"hg\")"}));
+}
+
+// Mie: dropletDiameter (µm) defaults to 20, must lie in the fit's range [0.1, 50] (phase_kinds.h),
+// and a "g" beside it is HG's key, ignored with the same warning as under isotropic.
+TEST(SceneLoad, MiePhaseFunctionTakesADropletDiameter) {
+  json j = minimalScene();
+  j["materials"][1]["phaseFunction"] = "mie";
+  Scene s = parseScene(j.dump(), "s.json");
+  EXPECT_EQ(s.materials[1].phase, PHASE_MIE);
+  EXPECT_EQ(s.materials[1].phaseParameter, 20.0f);
+  EXPECT_TRUE(s.warnings.empty());
+  j["materials"][1]["dropletDiameter"] = 8;
+  j["materials"][1]["g"] = 0.9;
+  s = parseScene(j.dump(), "s.json");
+  EXPECT_EQ(s.materials[1].phaseParameter, 8.0f);
+  EXPECT_EQ(s.warnings, (std::vector<std::string>{
+                            "s.json: materials[1].g: ignored by the mie phase function (use \"phaseFunction\": \"hg\")"}));
+  for (const auto& [d, message] : std::vector<std::pair<double, std::string>>{
+           {60, "s.json: materials[1].dropletDiameter: must be in [0.1, 50], got 60"},
+           {0.05, "s.json: materials[1].dropletDiameter: must be in [0.1, 50], got 0.05"}}) {
+    j["materials"][1]["dropletDiameter"] = d;
+    EXPECT_EQ(errorOf(j), message);
+  }
+  j = minimalScene();
+  j["materials"][1]["dropletDiameter"] = 10;
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
+            (std::vector<std::string>{"s.json: materials[1].dropletDiameter: ignored by the isotropic phase function "
+                                      "(use \"phaseFunction\": \"mie\")"}));
 }
 
 TEST(SceneWarnings, NoLightAndBlackBackground) {
