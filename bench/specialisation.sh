@@ -2,7 +2,7 @@
 # bench/specialisation.sh [--device SPEC] [--scenes "A.json B.json"] [--resolution WxH] [--spp N]
 #                         [--frames K] [--reps R] [--algorithms "pathtrace raymarch"]
 # Scene specialisation (issue 6, item 3; host/render/kernel_features.h): each scene rendered with
-# the kernel specialised for it (-DPHASE_FIXED_*, -DMEDIUM_GREY/CHROMATIC, -DLIGHTS_*_ONLY,
+# the kernel specialised for it (-DPHASE_FIXED=, -DMEDIUM_GREY/CHROMATIC, -DLIGHT_FIXED=,
 # -DCAMERA_PINHOLE, as the scene allows) and with the generic kernel (NARVAL_GENERIC=1), after one
 # warm-up of each (program build or cache load, first launch), then R alternating repetitions
 # (specialised, generic, specialised, ...) so both see the same machine load. pathtrace: kernel

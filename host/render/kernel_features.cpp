@@ -23,7 +23,7 @@ InputError unknownKind(const std::string& what, int kind) {
   return InputError("the kernels know no " + what + " kind " + std::to_string(kind));
 }
 
-// The id's own name (phase_kinds.h), as -DPHASE_FIXED takes it.
+// The id's own name (phase_kinds.h, light_kinds.h), as -DPHASE_FIXED and -DLIGHT_FIXED take it.
 std::string phaseKindId(int kind) {
   switch (kind) {
 #define PHASE_KIND_NAME(id, value, name, prefix, key, lo, hi, fallback) \
@@ -32,6 +32,15 @@ std::string phaseKindId(int kind) {
 #undef PHASE_KIND_NAME
   }
   throw unknownKind("phase function", kind);
+}
+std::string lightKindId(int kind) {
+  switch (kind) {
+#define LIGHT_KIND_NAME(id, value, name, prefix, scaled, area, vkey, key, lo, hi, fallback) \
+  case id: return #id;
+    LIGHT_KINDS(LIGHT_KIND_NAME)
+#undef LIGHT_KIND_NAME
+  }
+  throw unknownKind("light", kind);
 }
 
 }  // namespace
@@ -53,17 +62,13 @@ std::string sceneFeatureOptions(const DeviceScene& ds) {
       default: throw unknownKind("emission", sp.medium.emission.kind);
     }
   }
-  int rects = 0, points = 0;
-  for (int i = 0; i < sp.num_lights && size_t(i) < ds.lights.size(); ++i)
-    switch (ds.lights[size_t(i)].type) {
-      case LIGHT_RECTANGLE: ++rects; break;
-      case LIGHT_POINT: ++points; break;
-      default: throw unknownKind("light", ds.lights[size_t(i)].type);
-    }
-  if (rects == 0)
-    add("-DLIGHTS_POINT_ONLY");  // also with no light at all: nothing to intersect
-  else if (points == 0)
-    add("-DLIGHTS_RECT_ONLY");
+  // One kind for every light: fixed at build time (no light at all: nothing to fix).
+  std::string lightKind;
+  for (int i = 0; i < sp.num_lights && size_t(i) < ds.lights.size(); ++i) {
+    const std::string id = lightKindId(ds.lights[size_t(i)].type);
+    lightKind = i == 0 || id == lightKind ? id : "mixed";
+  }
+  if (!lightKind.empty() && lightKind != "mixed") add(("-DLIGHT_FIXED=" + lightKind).c_str());
   if (!(sp.camera.lens_radius > 0.0f)) add("-DCAMERA_PINHOLE");
   return o;
 }

@@ -9,8 +9,7 @@
 //   -DPHASE_FIXED=<id, e.g. PHASE_HG>            the medium's phase function      (phase.h)
 //   -DMEDIUM_GREY / -DMEDIUM_CHROMATIC           σ grey or not: analogue walk or
 //                                                spectral tracking only             (tracking.h)
-//   -DLIGHTS_POINT_ONLY / -DLIGHTS_RECT_ONLY     no rectangle light / only rectangles (intersect.h,
-//                                                                                   light.h, march.h)
+//   -DLIGHT_FIXED=<id, e.g. LIGHT_RECTANGLE>     every light is of that kind      (light.h)
 //   -DCAMERA_PINHOLE                             lens_radius not positive            (camera.h)
 //   -DEMISSION                                   the medium emits; without it no kernel
 //                                                function carries emission code      (emission.h)

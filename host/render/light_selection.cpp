@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "shared/light.h"
+
 namespace narval {
 namespace {
 
@@ -55,44 +57,36 @@ std::vector<WeightedPoint> mediumPoints(const DeviceScene& ds) {
   return out;
 }
 
-// ∫ Le dω of light l at point x, unshadowed: a rectangle as 4×4 patches (each cos θ_l·ΔA/d², zero
-// behind it), a point light I/d²; mean over the channels.
+// ∫ Le dω of light l at point x, unshadowed: an area light as 4×4 patches (each cos θ_l·ΔA/d², zero
+// behind it: the rectangle's corner and edges), any other light as its one point, I/d²; mean over
+// the channels.
 double fluenceAt(const light_params& l, const D3& x) {
-  auto inverseSquare = [&](const D3& y) {
-    const D3 to{x[0] - y[0], x[1] - y[1], x[2] - y[2]};
-    const double d2 = to[0] * to[0] + to[1] * to[1] + to[2] * to[2];
-    return std::pair<D3, double>{to, d2};
-  };
-  switch (l.type) {
-    case LIGHT_POINT: {
-      const auto [to, d2] = inverseSquare(d3(l.corner));
-      return d2 > 0 ? meanRgb(l.radiance) / d2 : 0.0;
-    }
-    case LIGHT_RECTANGLE: {
-      constexpr int n = 4;
-      const D3 c = d3(l.corner), eu = d3(l.edge_u), ev = d3(l.edge_v), nrm = d3(l.normal);
-      double sum = 0;
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-          const double s = (i + 0.5) / n, t = (j + 0.5) / n;
-          const D3 y{c[0] + s * eu[0] + t * ev[0], c[1] + s * eu[1] + t * ev[1], c[2] + s * eu[2] + t * ev[2]};
-          const auto [to, d2] = inverseSquare(y);
-          if (!(d2 > 0)) continue;
-          const double cosL = (to[0] * nrm[0] + to[1] * nrm[1] + to[2] * nrm[2]) / std::sqrt(d2);
-          if (cosL > 0) sum += cosL / d2;
-        }
-      return meanRgb(l.radiance) * sum * double(l.normal.w) / (n * n);
-    }
-    default: throw std::logic_error("fluenceAt: unknown light type " + std::to_string(l.type));
+  const vec3 xf = vec3_make(float(x[0]), float(x[1]), float(x[2]));
+  if (light_has_area(&l)) {
+    constexpr int n = 4;
+    const D3 c = d3(l.corner), eu = d3(l.edge_u), ev = d3(l.edge_v), nrm = d3(l.normal);
+    double sum = 0;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const double s = (i + 0.5) / n, t = (j + 0.5) / n;
+        const D3 y{c[0] + s * eu[0] + t * ev[0], c[1] + s * eu[1] + t * ev[1], c[2] + s * eu[2] + t * ev[2]};
+        const D3 to{x[0] - y[0], x[1] - y[1], x[2] - y[2]};
+        const double d2 = to[0] * to[0] + to[1] * to[1] + to[2] * to[2];
+        if (!(d2 > 0)) continue;
+        const double cosL = (to[0] * nrm[0] + to[1] * nrm[1] + to[2] * nrm[2]) / std::sqrt(d2);
+        if (cosL > 0) sum += cosL / d2;
+      }
+    return meanRgb(l.radiance) * sum * double(l.normal.w) / (n * n);
   }
+  light_point_view v;
+  if (!light_view_from(&l, xf, &v)) return 0.0;
+  const double r = v.range;
+  return (double(v.intensity.x) + v.intensity.y + v.intensity.z) / 3.0 / (r * r);
 }
 
 double lightPower(const light_params& l) {
-  switch (l.type) {
-    case LIGHT_POINT: return 4 * kPi * meanRgb(l.radiance);
-    case LIGHT_RECTANGLE: return kPi * double(l.normal.w) * meanRgb(l.radiance);
-    default: throw std::logic_error("lightPower: unknown light type " + std::to_string(l.type));
-  }
+  if (!light_known(l.type)) throw std::logic_error("lightPower: unknown light type " + std::to_string(l.type));
+  return light_power(&l);
 }
 
 }  // namespace

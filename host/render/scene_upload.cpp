@@ -15,6 +15,7 @@
 #include "render/kernel_features.h"
 #include "render/light_selection.h"
 #include "scene/input_error.h"
+#include "shared/light.h"
 #include "shared/phase.h"
 #include "volume/majorant_grid.h"
 
@@ -61,29 +62,37 @@ nv_affine rotationOnly(const Transform& t) {
   return transformMatrix(r);
 }
 
-light_params buildLight(const Primitive& p, const Material& m) {
-  light_params l{};
-  l.radiance = f4(m.albedo);
-  switch (p.type) {
-    case PrimitiveType::Point:
-      l.type = LIGHT_POINT;
-      l.corner = f4(p.transform.position);
-      return l;
-    case PrimitiveType::Rectangle: break;  // below
-    case PrimitiveType::Volume: throw std::logic_error("buildLight: a volume is not a light");
-  }
-  // The unit quad [-0.5, 0.5]² in local XY, emitting along local -Z (DESIGN.md, emitters). The
-  // emission direction follows the rotation alone: scale changes the extent, not the facing.
+// The radius of a sphere about the origin that holds the medium's box (its centre's distance plus
+// half its diagonal), 1 without a medium: the scale of a light from infinitely far.
+float sceneRadius(const Scene& scene) {
+  for (const Primitive& p : scene.primitives)
+    if (p.type == PrimitiveType::Volume) {
+      const Transform& t = p.transform;
+      return glm::length(v3(t.position)) + 0.5f * glm::length(v3(t.scale));
+    }
+  return 1.0f;
+}
+
+// The light of primitive p (light_kinds.h): its transform applied to the unit quad [-0.5, 0.5]² in
+// local XY, emitting along local -Z (DESIGN.md, emitters); the emission direction follows the
+// rotation alone (scale changes the extent, not the facing). Each kind takes what it needs.
+light_params buildLight(const Primitive& p, const Material& m, float sceneRadius) {
   const nv_affine M = transformMatrix(p.transform);
   const glm::vec3 corner = apply(M, {-0.5f, -0.5f, 0.0f}, 1.0f);
   const glm::vec3 eu = apply(M, {1, 0, 0}, 0.0f), ev = apply(M, {0, 1, 0}, 0.0f);
   const glm::vec3 n = normalized(apply(rotationOnly(p.transform), {0, 0, -1}, 0.0f));
-  l.type = LIGHT_RECTANGLE;
-  l.corner = f4(corner);
-  l.edge_u = f4(eu);
-  l.edge_v = f4(ev);
-  l.normal = f4(n, glm::length(glm::cross(eu, ev)));
-  return l;
+  auto toVec3 = [](const glm::vec3& a) { return vec3_make(a.x, a.y, a.z); };
+  light_placement pl;
+  pl.position = vec3_make(p.transform.position[0], p.transform.position[1], p.transform.position[2]);
+  pl.corner = toVec3(corner);
+  pl.edge_u = toVec3(eu);
+  pl.edge_v = toVec3(ev);
+  pl.normal = toVec3(n);
+  pl.area = glm::length(glm::cross(eu, ev));
+  pl.vector = vec3_make(p.lightVector[0], p.lightVector[1], p.lightVector[2]);
+  pl.parameter = p.lightParameter;
+  pl.scene_radius = sceneRadius;
+  return light_make(p.lightKind, vec3_make(m.albedo[0], m.albedo[1], m.albedo[2]), pl);
 }
 
 // The file's index-to-world map of a loaded grid as an nv_affine.
@@ -226,7 +235,7 @@ DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids) {
     const Primitive& p = scene.primitives[i];
     const Material& m = scene.materials.at(size_t(p.materialIndex));
     if (p.type != PrimitiveType::Volume) {
-      ds.lights.push_back(buildLight(p, m));
+      ds.lights.push_back(buildLight(p, m, sceneRadius(scene)));
       continue;
     }
     medium_params& med = sp.medium;

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "shared/light_kinds.h"
 #include "shared/phase_kinds.h"
 
 namespace narval {
@@ -56,11 +57,14 @@ struct Material {
   Emission emission;
 };
 
-enum class PrimitiveType { Rectangle, Volume, Point };
+enum class PrimitiveType { Volume, Light };
 
 struct Primitive {
   std::string name;
   PrimitiveType type = PrimitiveType::Volume;
+  int lightKind = -1;  // a light_kinds.h id when type is Light (its "type" names the kind)
+  Vec3f lightVector{0, 0, 0};  // the kind's own vector key (light_kinds.h), as loaded
+  float lightParameter = 0.0f;  // the kind's own number key, as loaded
   Transform transform;
   std::string materialName;
   int materialIndex = -1;  // resolved by the loader

@@ -125,6 +125,7 @@
 // any unknown key under --set, where a key the loader does not know is a typo. Every key is
 // documented in docs/scene-format.md (checked by tests/unit/scene_format_doc_test.cpp).
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -187,9 +188,33 @@ const EnumNames<int> kPhaseFunctions = {
 #undef PHASE_KIND_NAME
 };
 const EnumNames<GridSpace> kGridSpaces = {{"unit", GridSpace::Unit}, {"file", GridSpace::File}};
-const EnumNames<PrimitiveType> kPrimitiveTypes = {{"rectangle", PrimitiveType::Rectangle},
-                                                  {"volume", PrimitiveType::Volume},
-                                                  {"point", PrimitiveType::Point}};
+// A primitive's "type": a light kind's id (light_kinds.h), or kVolumeType.
+constexpr int kVolumeType = -1;
+const EnumNames<int> kPrimitiveTypes = {
+#define LIGHT_KIND_NAME(id, value, name, prefix, scaled, area, vkey, key, lo, hi, fallback) {name, id},
+    LIGHT_KINDS(LIGHT_KIND_NAME)
+#undef LIGHT_KIND_NAME
+    {"volume", kVolumeType}};
+// A light kind's loader columns (light_kinds.h).
+struct LightKindKeys {
+  int id;
+  const char* name;
+  int scaled;  // transform.scale components that must be non-zero; -1: no transform
+  const char* vectorKey;
+  const char* key;
+  float lo, hi, fallback;
+};
+const LightKindKeys kLightKindKeys[] = {
+#define LIGHT_KIND_KEYS(id, value, name, prefix, scaled, area, vkey, key, lo, hi, fallback) \
+  {id, name, scaled, vkey, key, lo, hi, fallback},
+    LIGHT_KINDS(LIGHT_KIND_KEYS)
+#undef LIGHT_KIND_KEYS
+};
+const LightKindKeys& lightKindKeys(int kind) {
+  for (const LightKindKeys& k : kLightKindKeys)
+    if (k.id == kind) return k;
+  throw std::logic_error("lightKindKeys: unknown light kind " + std::to_string(kind));
+}
 const EnumNames<ToneMapping> kToneMappings = {{"none", ToneMapping::None},
                                               {"reinhard", ToneMapping::Reinhard},
                                               {"aces", ToneMapping::Aces}};
@@ -219,8 +244,10 @@ const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
                                           {"lobe", Algorithm::Lobe}};
 
 const char* materialTypeName(MaterialType t) { return t == MaterialType::Emitter ? "emitter" : "volume"; }
-const char* primitiveTypeName(PrimitiveType t) {
-  return t == PrimitiveType::Rectangle ? "rectangle" : t == PrimitiveType::Volume ? "volume" : "point";
+const char* primitiveTypeName(const Primitive& p) {
+  for (const auto& [name, id] : kPrimitiveTypes)
+    if (id == (p.type == PrimitiveType::Volume ? kVolumeType : p.lightKind)) return name;
+  return "?";
 }
 
 // --- range checks: the message names the value as the user wrote it ---
@@ -389,26 +416,59 @@ Material readMaterial(JsonContext& ctx, const json& value, const std::string& ke
   return m;
 }
 
-Transform readTransform(JsonContext& ctx, const json& value, const std::string& key, PrimitiveType type) {
+Transform readTransform(JsonContext& ctx, const json& value, const std::string& key, const Primitive& p) {
   ObjectReader r(ctx, value, key);
   Transform t;
   t.position = r.getVec3("position", t.position);
   t.scale = r.getVec3("scale", t.scale);
   t.rotation = r.getVec3("rotation", t.rotation);
   // A zero scale collapses the box (or the light's quad, which lies in local XY) to nothing.
-  const size_t checked = type == PrimitiveType::Volume ? 3 : type == PrimitiveType::Rectangle ? 2 : 0;
-  for (size_t i = 0; i < checked; ++i)
-    if (t.scale[i] == 0) ctx.fail(indexKey(r.keyOf("scale"), i), "must be non-zero, got 0");
+  const int checked = p.type == PrimitiveType::Volume ? 3 : lightKindKeys(p.lightKind).scaled;
+  for (int i = 0; i < checked; ++i)
+    if (t.scale[size_t(i)] == 0) ctx.fail(indexKey(r.keyOf("scale"), size_t(i)), "must be non-zero, got 0");
   r.reportUnknown();
   return t;
+}
+
+// The light kinds' own keys (light_kinds.h): the primitive's kind's are read (its vector required
+// and non-zero, its number in range); another kind's, given, are named as ignored.
+void readLightKeys(ObjectReader& r, Primitive& p) {
+  const LightKindKeys* mine = p.type == PrimitiveType::Light ? &lightKindKeys(p.lightKind) : nullptr;
+  auto isMine = [&](const char* name) {
+    return mine && ((mine->vectorKey && std::strcmp(name, mine->vectorKey) == 0) || (mine->key && std::strcmp(name, mine->key) == 0));
+  };
+  for (const LightKindKeys& k : kLightKindKeys) {
+    for (const char* name : {k.vectorKey, k.key})
+      if (name && !isMine(name) && r.find(name))
+        r.context().warn(r.keyOf(name), std::string("ignored by a ") + primitiveTypeName(p) + " primitive");
+    if (&k != mine) continue;
+    if (k.vectorKey) {
+      p.lightVector = r.requireVec3(k.vectorKey);
+      if (p.lightVector == Vec3f{0, 0, 0}) r.context().fail(r.keyOf(k.vectorKey), "must be non-zero");
+    }
+    if (k.key) {
+      p.lightParameter = r.getFloat(k.key, k.fallback);
+      if (!(p.lightParameter >= k.lo && p.lightParameter <= k.hi))
+        r.context().fail(r.keyOf(k.key), "must be in [" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "], got " +
+                                             formatNumber(p.lightParameter));
+    }
+  }
 }
 
 Primitive readPrimitive(JsonContext& ctx, const json& value, const std::string& key) {
   ObjectReader r(ctx, value, key);
   Primitive p;
   p.name = r.getString("name", p.name);
-  p.type = requireEnum(r, "type", kPrimitiveTypes);
-  if (const json* t = r.find("transform")) p.transform = readTransform(ctx, *t, r.keyOf("transform"), p.type);
+  const int type = requireEnum(r, "type", kPrimitiveTypes);
+  p.type = type == kVolumeType ? PrimitiveType::Volume : PrimitiveType::Light;
+  p.lightKind = type == kVolumeType ? -1 : type;
+  if (const json* t = r.find("transform")) {
+    if (p.type == PrimitiveType::Light && lightKindKeys(p.lightKind).scaled < 0)
+      ctx.warn(r.keyOf("transform"), std::string("ignored by a ") + primitiveTypeName(p) + " light");
+    else
+      p.transform = readTransform(ctx, *t, r.keyOf("transform"), p);
+  }
+  readLightKeys(r, p);
   p.materialName = r.requireString("materialName");
   r.reportUnknown();
   return p;
@@ -620,7 +680,7 @@ void linkMaterial(const JsonContext& ctx, const Scene& scene, Primitive& p, cons
   const Material& m = scene.materials[p.materialIndex];
   const MaterialType wanted = p.type == PrimitiveType::Volume ? MaterialType::Volume : MaterialType::Emitter;
   if (m.type != wanted)
-    ctx.fail(key, std::string("a ") + primitiveTypeName(p.type) + " primitive needs " +
+    ctx.fail(key, std::string("a ") + primitiveTypeName(p) + " primitive needs " +
                       (wanted == MaterialType::Volume ? "a volume" : "an emitter") + " material; \"" + m.name +
                       "\" is " + (m.type == MaterialType::Volume ? "a " : "an ") + materialTypeName(m.type));
 }

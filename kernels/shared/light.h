@@ -1,72 +1,131 @@
-/* light.h: next-event estimation towards rectangle and point lights. */
+/* light.h: the lights, dispatched over the registry (light_kinds.h) to each kind's header.
+ * An unknown kind sends no light; every kernel's entry reports it (scene_kinds.h,
+ * STATUS_UNKNOWN_KIND) and the host never uploads one (render/kernel_features.h checks).
+ * Scene specialisation (host/render/kernel_features.h): -DLIGHT_FIXED=<id> when every light of the
+ * scene is of that kind, so the switches fold (a kind no ray can hit leaves light_hit_nearest
+ * nothing to do). Same arithmetic as the generic kernel. */
 #ifndef NARVAL_LIGHT_H
 #define NARVAL_LIGHT_H
 
-#include "shared/intersect.h"
-#include "shared/sampling.h"
+#include "shared/light_point.h"
+#include "shared/light_rectangle.h"
 
-typedef struct light_sample {
-  vec3 dir;       /* unit, from the shading point towards the light */
-  float dist;     /* to the sampled point */
-  vec3 radiance;  /* Le (rectangle) or I/d² (point), before transmittance and phase */
-  float pdf;      /* solid-angle pdf; 0 for a point light (a delta: no MIS) */
-} light_sample;
+#ifdef LIGHT_FIXED
+#define LIGHT_KIND(l) LIGHT_FIXED
+#else
+#define LIGHT_KIND(l) ((l)->type)
+#endif
 
-/* Aims s at y from x (unit direction, distance); returns d², or 0 when y is x (or NaN). */
-static inline float light_aim(vec3 y, vec3 x, NV_PRIVATE light_sample* s) {
-  const vec3 to = vec3_sub(y, x);
-  const float d2 = vec3_dot(to, to);
-  if (!(d2 > 0.0f)) return 0.0f;
-  s->dist = nv_sqrt(d2);
-  s->dir = vec3_scale(to, 1.0f / s->dist);
-  return d2;
+#define LIGHT_CASE_MAKE(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_make(l, pl);
+#define LIGHT_CASE_SAMPLE(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_sample(l, x, u1, u2, s);
+#define LIGHT_CASE_HIT(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_hit(l, o, d, t_min, front);
+#define LIGHT_CASE_PDF(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_pdf(l, d, t);
+#define LIGHT_CASE_AXIS(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_axis(l, x, dist);
+#define LIGHT_CASE_AREA(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return ar;
+#define LIGHT_CASE_VIEW(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_view_from(l, x, v);
+#define LIGHT_CASE_ESCAPED(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_escaped(l, d);
+#define LIGHT_CASE_POWER(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_power(l);
+
+/* A light of `kind` with `radiance` (its emitter's albedo) placed by pl (light_sample.h); an
+ * unknown kind keeps its id, so the checks downstream see it. */
+static inline light_params light_make(int kind, vec3 radiance, light_placement pl) {
+  light_params l;
+  l.corner = l.edge_u = l.edge_v = l.normal = vec3_to4(vec3_splat(0.0f), 0.0f);
+  l.radiance = vec3_to4(radiance, 0.0f);
+  l.type = kind;
+  l.select_prob = 0.0f;
+  l.pad0 = l.pad1 = 0;
+  switch (kind) {
+    LIGHT_KINDS(LIGHT_CASE_MAKE)
+    default: return l;
+  }
 }
 
-/* Samples light `l` as seen from x; returns 0 when it cannot contribute (back side, degenerate, an
- * unknown kind). */
+/* Samples light l as seen from x for next-event estimation; 0 when it cannot contribute (back
+ * side, degenerate, an unknown kind). */
 static inline int light_sample_point(NV_CONSTANT const light_params* l, vec3 x, float u1, float u2,
                                      NV_PRIVATE light_sample* s) {
   switch (LIGHT_KIND(l)) {
-    case LIGHT_POINT: {
-      const float d2 = light_aim(vec3_from4(l->corner), x, s);
-      if (!(d2 > 0.0f)) return 0;
-      s->radiance = vec3_scale(vec3_from4(l->radiance), 1.0f / d2);
-      s->pdf = 0.0f;
-      return 1;
-    }
-    case LIGHT_RECTANGLE: {
-      const vec3 y = vec3_add(vec3_from4(l->corner), vec3_add(vec3_scale(vec3_from4(l->edge_u), u1),
-                                                               vec3_scale(vec3_from4(l->edge_v), u2)));
-      const float d2 = light_aim(y, x, s);
-      if (!(d2 > 0.0f)) return 0;
-      /* Uniform on the area A, converted to solid angle: pdf = d² / (cos θ_l · A). */
-      const float cos_l = -vec3_dot(s->dir, vec3_from4(l->normal));
-      if (!(cos_l > 0.0f)) return 0;
-      s->radiance = vec3_from4(l->radiance);
-      s->pdf = d2 / (cos_l * l->normal.w);
-      return 1;
-    }
+    LIGHT_KINDS(LIGHT_CASE_SAMPLE)
     default: return 0; /* unknown: reported at the kernel's entry */
   }
 }
 
-/* Solid-angle pdf with which light_sample_point would pick the point hit at distance t along the
- * unit direction d (for MIS on phase-sampled rays that hit a rectangle light). */
-static inline float light_pdf_rectangle(NV_CONSTANT const light_params* l, vec3 d, float t) {
-  const float cos_l = -vec3_dot(d, vec3_from4(l->normal));
-  return cos_l > 0.0f ? t * t / (cos_l * l->normal.w) : 0.0f;
+/* Where the ray o + t·d (t > t_min) meets light l's surface, NV_INFINITY where it does not (a
+ * delta light never); *front: 1 on the emitting side. */
+static inline float light_hit(NV_CONSTANT const light_params* l, vec3 o, vec3 d, float t_min, NV_PRIVATE int* front) {
+  switch (LIGHT_KIND(l)) {
+    LIGHT_KINDS(LIGHT_CASE_HIT)
+    default: return NV_INFINITY;
+  }
 }
 
-/* A light's one point: a point light's position, a rectangle's centre (an unknown kind: its corner;
- * it sends nothing). Where the real-time kernels put a light (march_light_as_point) and where the
- * cache's guide aims (phase_guide.h). */
-static inline vec3 light_centre(NV_CONSTANT const light_params* l) {
-  const vec3 p = vec3_from4(l->corner);
+/* The solid-angle pdf with which light_sample_point picks the direction d that meets the light at
+ * distance t (MIS for the phase-sampled rays that hit it); 0 for a delta light. */
+static inline float light_pdf(NV_CONSTANT const light_params* l, vec3 d, float t) {
   switch (LIGHT_KIND(l)) {
-    case LIGHT_RECTANGLE: return vec3_add(p, vec3_scale(vec3_add(vec3_from4(l->edge_u), vec3_from4(l->edge_v)), 0.5f));
-    case LIGHT_POINT: return p;
-    default: return p;
+    LIGHT_KINDS(LIGHT_CASE_PDF)
+    default: return 0.0f;
   }
+}
+
+/* The radiance of light l that a ray escaping the scene along d sees (a light at infinity). */
+static inline vec3 light_escaped(NV_CONSTANT const light_params* l, vec3 d) {
+  switch (LIGHT_KIND(l)) {
+    LIGHT_KINDS(LIGHT_CASE_ESCAPED)
+    default: return vec3_splat(0.0f);
+  }
+}
+
+/* Unit direction from x towards the light's centre (0 when x is there) and *dist, the distance
+ * to it: the cache's guide's axis, and the real-time shadow ray of a light taken as one point. */
+static inline vec3 light_axis(NV_CONSTANT const light_params* l, vec3 x, NV_PRIVATE float* dist) {
+  switch (LIGHT_KIND(l)) {
+    LIGHT_KINDS(LIGHT_CASE_AXIS)
+    default: *dist = 0.0f; return vec3_splat(0.0f);
+  }
+}
+
+/* 1 for a light with an area the real-time kernels split (light_rectangle_area.h). */
+static inline int light_has_area(NV_CONSTANT const light_params* l) {
+  switch (LIGHT_KIND(l)) {
+    LIGHT_KINDS(LIGHT_CASE_AREA)
+    default: return 0;
+  }
+}
+
+/* The light as one point seen from x (light_point_view); 0 when it sends nothing to x. */
+static inline int light_view_from(NV_CONSTANT const light_params* l, vec3 x, NV_PRIVATE light_point_view* v) {
+  switch (LIGHT_KIND(l)) {
+    LIGHT_KINDS(LIGHT_CASE_VIEW)
+    default: return 0; /* unknown: reported at the kernel's entry */
+  }
+}
+
+/* Emitted power (mean over the channels), for light selection by power (render/light_selection). */
+static inline float light_power(NV_CONSTANT const light_params* l) {
+  switch (l->type) {
+    LIGHT_KINDS(LIGHT_CASE_POWER)
+    default: return 0.0f;
+  }
+}
+
+/* The nearest light surface along the ray beyond t_min (index or -1), skipping light `skip`. */
+static inline int light_hit_nearest(NV_CONSTANT const light_params* lights, int num_lights, vec3 o, vec3 d,
+                                    float t_min, int skip, NV_PRIVATE float* t_hit, NV_PRIVATE int* front) {
+  int hit = -1;
+  *t_hit = NV_INFINITY;
+  for (int i = 0; i < num_lights; ++i) {
+    if (i == skip) continue;
+    int f = 0;
+    const float t = light_hit(&lights[i], o, d, t_min, &f);
+    if (t < *t_hit) {
+      *t_hit = t;
+      *front = f;
+      hit = i;
+    }
+  }
+  return hit;
 }
 
 #endif

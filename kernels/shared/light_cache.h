@@ -73,7 +73,7 @@ static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_CO
   return light_cache_column_at(c, cache, light, dims, vec3_madd(seg.o, seg.d, seg.t0));
 }
 
-/* Optical depth τ from x to light `light` (unit `dir`, `dist` from march_light_as_point), per
+/* Optical depth τ from x to light `light` (unit `dir`, `dist` from light_view_from), per
  * channel: one cache lookup when the cache is on, else the exact shadow march of shadow_steps
  * samples (the kernels' pixels before the cache, bit for bit). Both real-time kernels call this
  * for every shadow ray. */
@@ -86,7 +86,7 @@ static inline vec3 light_cache_optical_depth(KERNEL_CONTEXT_PARAM,
   const vec3 sigma_t_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
   if (rp->light_cache.nx > 0)
     return vec3_scale(sigma_t_unit, light_cache_column(m, &rp->light_cache, cache, light, x, dir, dist, status));
-  if (rp->shadow_area_samples > 1 && LIGHT_IS_RECT(&lights[light])) /* the columns the cache would hold */
+  if (rp->shadow_area_samples > 1 && light_has_area(&lights[light])) /* the columns the cache would hold */
     return vec3_scale(sigma_t_unit,
                       march_light_column(KERNEL_CONTEXT_ARG, &lights[light], x, rp->shadow_area_samples,
                                          rp->shadow_steps, rp->shadow_weighting, view_dir));

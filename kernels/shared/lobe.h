@@ -40,7 +40,7 @@
  * 4. Transmittances by the midpoint rule (true step lengths, all channels, only the part inside
  *    the box): Tr(x0 → P_i) over view_steps samples, Tr(P_i → light) by light_cache_optical_depth
  *    (one lookup in the light-transmittance cache, or the exact march of shadow_steps), lights as
- *    points (march_light_as_point: a rectangle is a point at its centre with intensity
+ *    points (light_view_from: a rectangle is a point at its centre with intensity
  *    Le·A·max(0, cos θ_light), as DESIGN.md allows for real-time kernels).
  *    Shadow rays see only the medium, not other rectangles. cos θ_i = dot(normalize(P_i − light),
  *    −d_i): light propagating from the light to P_i, then from P_i towards c. albedo = σs/σt per
@@ -178,11 +178,11 @@ static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
   NV_CONSTANT const medium_params* m = &s->medium;
   const vec3 w_out = vec3_scale(d, -1.0f); /* from P towards c */
   for (int k = 0; k < s->num_lights; ++k) {
-    vec3 to_light, I;
-    float dist;
-    if (!march_light_as_point(&lights[k], P, &to_light, &dist, &I)) continue;
+    light_point_view v;
+    if (!light_view_from(&lights[k], P, &v)) continue;
+    const vec3 to_light = v.dir;
     const vec3 tr =
-        vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, p, light_cache, k, P, to_light, dist, d));
+        vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, p, light_cache, k, P, to_light, v.dist, d));
     if (p->area_light_samples > 1 || p->area_light_phase != AREA_LIGHT_POINTS) {
       /* rectangles as K×K points or integrated exactly (march_light_phase) */
       *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase(&lights[k], P, m->phase, d, p->area_light_phase,
@@ -195,7 +195,7 @@ static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
       if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
       continue;
     }
-    *in_sum = vec3_add(*in_sum, vec3_scale(vec3_mul(tr, I), f / (dist * dist)));
+    *in_sum = vec3_add(*in_sum, vec3_scale(vec3_mul(tr, v.intensity), f / (v.range * v.range)));
   }
 }
 

@@ -1,10 +1,10 @@
 /* pathtrace.h: one path-traced sample of a pixel (DESIGN.md "pathtrace"; dissertation §4.2-4.3).
  * Free flight by delta/spectral tracking, next-event estimation at every real scattering event
- * (ratio-tracked shadow rays to every light or to one picked per event (light_select.h), rectangle
- * lights MIS-combined with phase sampling by the power heuristic, point lights by NEE alone),
- * Russian roulette on shadow rays as the scene asks (tracking.h), `max_bounces` real scattering
- * events, escaped rays add the emitter they hit or the background. Rectangles are opaque: their
- * back side is black.
+ * (ratio-tracked shadow rays to every light or to one picked per event (light_select.h), lights
+ * with an extent MIS-combined with phase sampling by the power heuristic, delta lights by NEE
+ * alone; light.h), Russian roulette on shadow rays as the scene asks (tracking.h), `max_bounces`
+ * real scattering events; a ray adds the light surface it hits, or on escaping the background and
+ * the lights at infinity along it. Light surfaces are opaque: a rectangle's back side is black.
  * No Russian roulette on the path's throughput (pbrt-v4's volumetric path tracer has one): here it
  * could never play. The grey analogue walk keeps β = 1, and spectral tracking keeps the mean of β's
  * channels at 1 (tracking.h: a real or null event multiplies β by σ_x·c/(σ̄·avg(σ_x ⊙ β)) with
@@ -37,7 +37,7 @@ static inline vec3 pathtrace_shadow(KERNEL_CONTEXT_PARAM, int light_index, vec3 
   NV_CONSTANT const light_params* lights = ctx->lights;
   float t_block;
   int front;
-  if (intersect_lights(lights, s->num_lights, x, dir, 0.0f, light_index, &t_block, &front) >= 0 &&
+  if (light_hit_nearest(lights, s->num_lights, x, dir, 0.0f, light_index, &t_block, &front) >= 0 &&
       t_block < dist)
     return vec3_splat(0.0f);
   medium_segment seg;
@@ -125,6 +125,25 @@ static inline vec3 pathtrace_direct(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, NV_
   }
 }
 
+/* What the lights at infinity send along −d to a ray escaping the scene along d, each MIS-weighted
+ * against its next-event estimate as a light surface's hit is (prev_phase_pdf 0: the camera's ray,
+ * unweighted). */
+static inline vec3 pathtrace_escaped(KERNEL_CONTEXT_PARAM, vec3 d, float prev_phase_pdf) {
+  NV_CONSTANT const scene_params* s = ctx->scene;
+  NV_CONSTANT const light_params* lights = ctx->lights;
+  vec3 sum = vec3_splat(0.0f);
+  for (int i = 0; i < s->num_lights; ++i) {
+    const vec3 Le = light_escaped(&lights[i], d);
+    if (vec3_is_zero(Le)) continue;
+    const float w = prev_phase_pdf > 0.0f
+                        ? mis_power_heuristic(prev_phase_pdf, light_select_prob(s, lights, i) *
+                                                                  light_pdf(&lights[i], d, NV_INFINITY))
+                        : 1.0f;
+    sum = vec3_add(sum, vec3_scale(Le, w));
+  }
+  return sum;
+}
+
 /* Radiance arriving at o from the direction −d, by one path: the ray o + t·d, then up to max_bounces
  * real scattering events. unscattered_emitters 0 drops the emitter the first segment may hit (the
  * unscattered light of the lights, which the ray marcher adds itself: the multiple-scattering
@@ -148,7 +167,7 @@ static inline vec3 pathtrace_radiance(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, int 
   for (;;) {
     float t_surf;
     int front = 0;
-    const int light_hit = intersect_lights(lights, s->num_lights, o, d, 0.0f, -1, &t_surf, &front);
+    const int light_hit = light_hit_nearest(lights, s->num_lights, o, d, 0.0f, -1, &t_surf, &front);
     medium_segment seg;
     if (s->has_medium && medium_intersect(&s->medium, o, d, 0.0f, t_surf, &seg)) {
       float t_hit;
@@ -178,11 +197,13 @@ static inline vec3 pathtrace_radiance(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, int 
         float w = 1.0f;
         if (prev_phase_pdf > 0.0f)
           w = mis_power_heuristic(prev_phase_pdf, light_select_prob(s, lights, light_hit) *
-                                                      light_pdf_rectangle(&lights[light_hit], d, t_surf));
+                                                      light_pdf(&lights[light_hit], d, t_surf));
         L = vec3_add(L, vec3_scale(vec3_mul(beta, vec3_from4(lights[light_hit].radiance)), w));
       }
     } else {
-      L = vec3_add(L, vec3_mul(beta, vec3_from4(s->background)));
+      vec3 Le = vec3_from4(s->background);
+      if (unscattered_emitters || depth > 0) Le = vec3_add(Le, pathtrace_escaped(KERNEL_CONTEXT_ARG, d, prev_phase_pdf));
+      L = vec3_add(L, vec3_mul(beta, Le));
     }
     break;
   }

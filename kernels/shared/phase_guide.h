@@ -36,9 +36,8 @@ static inline phase_guide phase_guide_none(void) {
 
 /* Unit direction from x to light l's centre (a point light's position); 0 when x is there. */
 static inline vec3 phase_guide_axis(NV_CONSTANT const light_params* l, vec3 x) {
-  const vec3 to = vec3_sub(light_centre(l), x);
-  const float d = vec3_length(to);
-  return d > 0.0f ? vec3_scale(to, 1.0f / d) : vec3_splat(0.0f);
+  float d;
+  return light_axis(l, x, &d);
 }
 
 /* The guide's own density at ω: (1/n)·Σ_k p_HG(g, a_k·ω). */

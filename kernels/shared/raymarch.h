@@ -18,7 +18,7 @@
  *   L  += T ⊙ (S_k − S_k ⊙ e^{−σt(x_k)·Δ}) / σt(x_k)      (energy-conserving step, exact for
  *   T  ⊙= e^{−σt(x_k)·Δ}                                     S and σt constant over the step)
  * and the pixel is L + T ⊙ L_b (L_b: march_background, what the ray sees with the medium removed).
- * Lights are points (march_light_as_point: a rectangle is a point at its centre with intensity
+ * Lights are points (light_view_from: a rectangle is a point at its centre with intensity
  * Le·A·max(0, cos θ_light), the approximation DESIGN.md allows here) unless area_light_samples
  * K > 1 (the phase and 1/d² over K×K points of a rectangle) or area_light_phase is AREA_LIGHT_EXACT
  * (the phase integrated over the rectangle's solid angle, march_light_phase); other emitters do not
@@ -90,10 +90,10 @@ static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
   NV_CONSTANT const medium_params* m = &s->medium;
   vec3 sum = vec3_splat(0.0f);
   for (int l = 0; l < s->num_lights; ++l) {
-    vec3 dir, I;
-    float dist;
-    if (!march_light_as_point(&lights[l], x, &dir, &dist, &I)) continue;
-    const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, rp, light_cache, l, x, dir, dist, view_dir);
+    light_point_view v;
+    if (!light_view_from(&lights[l], x, &v)) continue;
+    const vec3 dir = v.dir;
+    const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, rp, light_cache, l, x, dir, v.dist, view_dir);
     if (rp->area_light_samples > 1 || rp->area_light_phase != AREA_LIGHT_POINTS) {
       /* Rectangles as K×K points or integrated exactly (march_light_phase), one shadow for all. */
       const int K = rp->area_light_samples, mode = rp->area_light_phase;
@@ -123,7 +123,7 @@ static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
         oct = vec3_add(oct, vec3_scale(vec3_exp_neg(vec3_scale(tau, bi)), ai * p));
       }
     }
-    sum = vec3_add(sum, vec3_mul(vec3_scale(I, 1.0f / (dist * dist)), oct));
+    sum = vec3_add(sum, vec3_mul(vec3_scale(v.intensity, 1.0f / (v.range * v.range)), oct));
   }
   return sum;
 }

@@ -29,11 +29,7 @@ static inline uint scene_kinds_status(NV_CONSTANT const scene_params* s, NV_CONS
     default: status |= STATUS_UNKNOWN_KIND;
   }
   for (int i = 0; i < s->num_lights; ++i) {
-    switch (lights[i].type) {
-      case LIGHT_RECTANGLE:
-      case LIGHT_POINT: break;
-      default: status |= STATUS_UNKNOWN_KIND;
-    }
+    if (!light_known(lights[i].type)) status |= STATUS_UNKNOWN_KIND;
   }
   return status;
 }

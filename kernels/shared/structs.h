@@ -4,6 +4,7 @@
 #ifndef NARVAL_STRUCTS_H
 #define NARVAL_STRUCTS_H
 
+#include "shared/light_kinds.h"
 #include "shared/phase_kinds.h"
 #include "shared/vec3.h"
 
@@ -11,9 +12,6 @@
 #define LIGHT_SAMPLING_ALL 0 /* a shadow ray to every light at every scattering event */
 #define LIGHT_SAMPLING_ONE 1 /* one light per event, picked with light_params.select_prob */
 
-/* Light types (light_params.type). */
-#define LIGHT_RECTANGLE 0
-#define LIGHT_POINT 1
 
 /* Status word bits: kernels OR these into a global uint; the host reports them. */
 #define STATUS_NAN 1u

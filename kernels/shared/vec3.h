@@ -11,6 +11,14 @@ typedef struct nv_float4 {
 } nv_float4;
 
 static inline vec3 vec3_from4(nv_float4 v) { return vec3_make(v.x, v.y, v.z); }
+static inline nv_float4 vec3_to4(vec3 v, float w) {
+  nv_float4 r;
+  r.x = v.x;
+  r.y = v.y;
+  r.z = v.z;
+  r.w = w;
+  return r;
+}
 static inline vec3 vec3_splat(float s) { return vec3_make(s, s, s); }
 static inline vec3 vec3_add(vec3 a, vec3 b) { return vec3_make(a.x + b.x, a.y + b.y, a.z + b.z); }
 static inline vec3 vec3_sub(vec3 a, vec3 b) { return vec3_make(a.x - b.x, a.y - b.y, a.z - b.z); }

@@ -77,20 +77,19 @@ TEST(KernelFeatures, OptionsDerivedFromTheScene) {
       {{"hg", false, true, true, true}, true, "-DPHASE_FIXED=PHASE_HG -DMEDIUM_CHROMATIC",
        "-DPHASE_FIXED=PHASE_HG -DMEDIUM_CHROMATIC"},
       {{"isotropic", true, true, false, false}, true,
-       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE",
-       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE"},
-      {{"hg", true, false, true, false}, false, "-DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE",
-       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE"},
+       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHT_FIXED=LIGHT_RECTANGLE -DCAMERA_PINHOLE",
+       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHT_FIXED=LIGHT_RECTANGLE -DCAMERA_PINHOLE"},
+      {{"hg", true, false, true, false}, false, "-DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DLIGHT_FIXED=LIGHT_POINT -DCAMERA_PINHOLE",
+       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DLIGHT_FIXED=LIGHT_POINT -DCAMERA_PINHOLE"},
       // No medium: no phase or σ feature.
-      {{"hg", false, true, false, true, false}, false, "-DLIGHTS_RECT_ONLY", "-DMEDIUM_HOMOGENEOUS -DLIGHTS_RECT_ONLY"},
+      {{"hg", false, true, false, true, false}, false, "-DLIGHT_FIXED=LIGHT_RECTANGLE", "-DMEDIUM_HOMOGENEOUS -DLIGHT_FIXED=LIGHT_RECTANGLE"},
       // An emitting medium: its kernels carry emission (emission.h).
       {{"hg", true, true, false, false, true, true}, false,
-       "-DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DEMISSION -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE",
-       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DEMISSION -DLIGHTS_RECT_ONLY -DCAMERA_PINHOLE"},
-      // No light at all: nothing to intersect, as with point lights only.
-      {{"isotropic", true, false, false, false}, true,
-       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE",
-       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DLIGHTS_POINT_ONLY -DCAMERA_PINHOLE"},
+       "-DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DEMISSION -DLIGHT_FIXED=LIGHT_RECTANGLE -DCAMERA_PINHOLE",
+       "-DMEDIUM_HOMOGENEOUS -DPHASE_FIXED=PHASE_HG -DMEDIUM_GREY -DEMISSION -DLIGHT_FIXED=LIGHT_RECTANGLE -DCAMERA_PINHOLE"},
+      // No light at all: no kind to fix.
+      {{"isotropic", true, false, false, false}, true, "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DCAMERA_PINHOLE",
+       "-DPHASE_FIXED=PHASE_ISOTROPIC -DMEDIUM_GREY -DCAMERA_PINHOLE"},
   };
   for (const Case& c : cases) {
     const std::string json = sceneJson(c.spec);

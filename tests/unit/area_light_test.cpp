@@ -105,7 +105,8 @@ const D3 kView = {0.0, 0.6, 0.8};
 TEST(AreaLight, PhaseSumAndColumnConvergeToTheIntegralsOverTheLight) {
   Fixture f;
   const light_params& l = f.ds.lights[0];
-  ASSERT_TRUE(LIGHT_IS_RECT(&l));
+  ASSERT_EQ(l.type, LIGHT_RECTANGLE);
+  ASSERT_TRUE(light_has_area(&l));
   const medium_params& m = f.ds.params.medium;
   const double sigma = 2.0;
   double worstK1 = 0;
@@ -124,11 +125,10 @@ TEST(AreaLight, PhaseSumAndColumnConvergeToTheIntegralsOverTheLight) {
       EXPECT_NEAR(column, ref.column, tol * ref.column) << "K " << K;
     }
     // K = 1: the centre.
-    vec3 dir, I;
-    float dist;
-    ASSERT_TRUE(march_light_as_point(&l, xf, &dir, &dist, &I));
+    light_point_view v;
+    ASSERT_TRUE(light_view_from(&l, xf, &v));
     const vec3 centre = march_light_phase_sum(&l, xf, m.phase, vf, 1);
-    const double point = I.x * hg(0.8, dot(kView, {dir.x, dir.y, dir.z})) / (double(dist) * dist);
+    const double point = v.intensity.x * hg(0.8, dot(kView, {v.dir.x, v.dir.y, v.dir.z})) / (double(v.dist) * v.dist);
     EXPECT_NEAR(centre.x, point, 1e-5 * point);
     const D3 c = {l.corner.x + 0.5 * (l.edge_u.x + l.edge_v.x), l.corner.y + 0.5 * (l.edge_u.y + l.edge_v.y),
                   l.corner.z + 0.5 * (l.edge_u.z + l.edge_v.z)};

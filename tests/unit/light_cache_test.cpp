@@ -57,10 +57,9 @@ Cache buildCache(const std::string& json, int cells, int steps = 16, const Dense
 // The cached column density from world point x to light 0.
 double cachedColumn(const Cache& c, const double x[3], uint* status) {
   const vec3 p = vec3_make(float(x[0]), float(x[1]), float(x[2]));
-  vec3 dir, I;
-  float dist;
-  EXPECT_TRUE(march_light_as_point(&c.ds.lights[0], p, &dir, &dist, &I));
-  return light_cache_column(&c.ds.params.medium, &c.params.light_cache, c.slabs.data(), 0, p, dir, dist, status);
+  light_point_view v;
+  EXPECT_TRUE(light_view_from(&c.ds.lights[0], p, &v));
+  return light_cache_column(&c.ds.params.medium, &c.params.light_cache, c.slabs.data(), 0, p, v.dir, v.dist, status);
 }
 
 // Length of the segment a → b inside the unit cube [-0.5, 0.5]³ (slab method, double).
@@ -219,13 +218,12 @@ TEST(LightCache, EmptyGridGivesTransmittanceOneExactly) {
   realtime_params params = c.params;
   for (int i = 0; i < 200; ++i) {
     const vec3 p = vec3_make(float(u(rng)), float(u(rng)), float(u(rng)));
-    vec3 dir, I;
-    float dist;
+    light_point_view v;
     uint status = 0;
-    ASSERT_TRUE(march_light_as_point(&c.ds.lights[0], p, &dir, &dist, &I));
+    ASSERT_TRUE(light_view_from(&c.ds.lights[0], p, &v));
     const vec3 tr = vec3_exp_neg(
         light_cache_optical_depth(narval::test::sceneContext(&c.ds.params, c.ds.lights.data(), &c.grid, &status),
-                                  &params, c.slabs.data(), 0, p, dir, dist, vec3_make(0, 0, 1)));
+                                  &params, c.slabs.data(), 0, p, v.dir, v.dist, vec3_make(0, 0, 1)));
     ASSERT_EQ(tr.x, 1.0f);
     ASSERT_EQ(tr.y, 1.0f);
     ASSERT_EQ(tr.z, 1.0f);

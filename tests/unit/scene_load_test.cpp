@@ -108,7 +108,8 @@ TEST_F(SceneFiles, Listing41LoadsAsPrinted) {
   ASSERT_EQ(s.primitives.size(), 2u);
   const Primitive& light = s.primitives[0];
   EXPECT_EQ(light.name, "rectLight");
-  EXPECT_EQ(light.type, PrimitiveType::Rectangle);
+  EXPECT_EQ(light.type, PrimitiveType::Light);
+  EXPECT_EQ(light.lightKind, LIGHT_RECTANGLE);
   EXPECT_EQ(light.transform.position, (Vec3f{0, 0, 80}));
   EXPECT_EQ(light.transform.scale, (Vec3f{150, 100, 1}));
   EXPECT_EQ(light.transform.rotation, (Vec3f{0, 0, 0}));
@@ -207,7 +208,8 @@ TEST(SceneDefaults, ExtensionsAreRead) {
   EXPECT_EQ(s.materials[1].gridSpace, GridSpace::File);
   EXPECT_EQ(s.materials[1].density, 0.0f);
   ASSERT_EQ(s.primitives.size(), 3u);
-  EXPECT_EQ(s.primitives[2].type, PrimitiveType::Point);
+  EXPECT_EQ(s.primitives[2].type, PrimitiveType::Light);
+  EXPECT_EQ(s.primitives[2].lightKind, LIGHT_POINT);
   EXPECT_EQ(s.primitives[2].materialIndex, 0);
   EXPECT_EQ(s.primitives[2].transform.position, (Vec3f{1, 2, 3}));
   EXPECT_EQ(s.primitives[2].transform.scale, (Vec3f{1, 1, 1}));
@@ -324,7 +326,7 @@ TEST(SceneErrors, BadValuesNameFileKeyAndProblem) {
       {"/materials/0/type", "light", "s.json: materials[0].type: unknown value \"light\" (allowed: emitter, volume)"},
       {"/materials/1/phaseFunction", "rayleigh", "s.json: materials[1].phaseFunction: unknown value \"rayleigh\" (allowed: isotropic, hg, mie)"},
       {"/materials/1/gridSpace", "world", "s.json: materials[1].gridSpace: unknown value \"world\" (allowed: unit, file)"},
-      {"/primitives/1/type", "sphere", "s.json: primitives[1].type: unknown value \"sphere\" (allowed: rectangle, volume, point)"},
+      {"/primitives/1/type", "sphere", "s.json: primitives[1].type: unknown value \"sphere\" (allowed: rectangle, point, volume)"},
       {"/renderer/algorithm", "mlt", "s.json: renderer.algorithm: unknown value \"mlt\" (allowed: pathtrace, raymarch, lobe)"},
       {"/renderer/storage", "texture", "s.json: renderer.storage: unknown value \"texture\" (allowed: auto, image, buffer, bricks)"},
       {"/renderer/storage", true, "s.json: renderer.storage: expected a string, got boolean"},
