@@ -7,6 +7,7 @@
 #ifndef NARVAL_LIGHT_H
 #define NARVAL_LIGHT_H
 
+#include "shared/light_distant.h"
 #include "shared/light_point.h"
 #include "shared/light_rectangle.h"
 

@@ -13,7 +13,8 @@
 
 #define LIGHT_KINDS(X)                                \
   X(LIGHT_RECTANGLE, 0, "rectangle", rectangle, 2, 1, 0, 0, 0.0f, 0.0f, 0.0f) \
-  X(LIGHT_POINT, 1, "point", point, 0, 0, 0, 0, 0.0f, 0.0f, 0.0f)
+  X(LIGHT_POINT, 1, "point", point, 0, 0, 0, 0, 0.0f, 0.0f, 0.0f) \
+  X(LIGHT_DISTANT, 2, "distant", distant, -1, 0, "direction", "angularDiameter", 0.0f, 180.0f, 0.0f)
 
 #define LIGHT_KIND_ID(id, value, name, prefix, scaled, area, vkey, key, lo, hi, fallback) id = value,
 enum light_kind { LIGHT_KINDS(LIGHT_KIND_ID) };

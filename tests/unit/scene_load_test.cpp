@@ -326,7 +326,7 @@ TEST(SceneErrors, BadValuesNameFileKeyAndProblem) {
       {"/materials/0/type", "light", "s.json: materials[0].type: unknown value \"light\" (allowed: emitter, volume)"},
       {"/materials/1/phaseFunction", "rayleigh", "s.json: materials[1].phaseFunction: unknown value \"rayleigh\" (allowed: isotropic, hg, mie)"},
       {"/materials/1/gridSpace", "world", "s.json: materials[1].gridSpace: unknown value \"world\" (allowed: unit, file)"},
-      {"/primitives/1/type", "sphere", "s.json: primitives[1].type: unknown value \"sphere\" (allowed: rectangle, point, volume)"},
+      {"/primitives/1/type", "sphere", "s.json: primitives[1].type: unknown value \"sphere\" (allowed: rectangle, point, distant, volume)"},
       {"/renderer/algorithm", "mlt", "s.json: renderer.algorithm: unknown value \"mlt\" (allowed: pathtrace, raymarch, lobe)"},
       {"/renderer/storage", "texture", "s.json: renderer.storage: unknown value \"texture\" (allowed: auto, image, buffer, bricks)"},
       {"/renderer/storage", true, "s.json: renderer.storage: expected a string, got boolean"},
@@ -497,6 +497,36 @@ TEST(SceneLoad, MiePhaseFunctionTakesADropletDiameter) {
   EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
             (std::vector<std::string>{"s.json: materials[1].dropletDiameter: ignored by the isotropic phase function "
                                       "(use \"phaseFunction\": \"mie\")"}));
+}
+
+// A distant light (light_distant.h): "direction" required and non-zero, "angularDiameter" in
+// [0, 180] (default 0, a delta light); it takes no transform, and its keys on another primitive are
+// named as ignored.
+TEST(SceneLoad, DistantLightTakesADirectionAndAnAngularDiameter) {
+  json j = minimalScene();
+  j["primitives"][0] = {{"type", "distant"}, {"direction", {0, -1, 0}}, {"materialName", "light"}};
+  Scene s = parseScene(j.dump(), "s.json");
+  EXPECT_EQ(s.primitives[0].type, PrimitiveType::Light);
+  EXPECT_EQ(s.primitives[0].lightKind, LIGHT_DISTANT);
+  EXPECT_EQ(s.primitives[0].lightVector, (Vec3f{0, -1, 0}));
+  EXPECT_EQ(s.primitives[0].lightParameter, 0.0f);
+  EXPECT_TRUE(s.warnings.empty());
+  j["primitives"][0]["angularDiameter"] = 0.53;
+  j["primitives"][0]["transform"] = {{"position", {1, 2, 3}}};
+  s = parseScene(j.dump(), "s.json");
+  EXPECT_EQ(s.primitives[0].lightParameter, 0.53f);
+  EXPECT_EQ(s.warnings, (std::vector<std::string>{"s.json: primitives[0].transform: ignored by a distant light"}));
+  j["primitives"][0]["angularDiameter"] = 181;
+  EXPECT_EQ(errorOf(j), "s.json: primitives[0].angularDiameter: must be in [0, 180], got 181");
+  j["primitives"][0]["angularDiameter"] = 1;
+  j["primitives"][0]["direction"] = {0, 0, 0};
+  EXPECT_EQ(errorOf(j), "s.json: primitives[0].direction: must be non-zero");
+  j["primitives"][0].erase("direction");
+  EXPECT_EQ(errorOf(j), "s.json: primitives[0].direction: missing required key");
+  j = minimalScene();
+  j["primitives"][0]["direction"] = {0, -1, 0};
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
+            (std::vector<std::string>{"s.json: primitives[0].direction: ignored by a rectangle primitive"}));
 }
 
 TEST(SceneWarnings, NoLightAndBlackBackground) {
