@@ -55,12 +55,9 @@ std::string sceneFeatureOptions(const DeviceScene& ds) {
   if (sp.has_medium) {
     add(("-DPHASE_FIXED=" + phaseKindId(sp.medium.phase.kind)).c_str());
     add(sp.medium.grey ? "-DMEDIUM_GREY" : "-DMEDIUM_CHROMATIC");
-    switch (sp.medium.emission.kind) {
-      case EMISSION_NONE: break;
-      case EMISSION_COLOR:
-      case EMISSION_BLACKBODY: add("-DEMISSION"); break;
-      default: throw unknownKind("emission", sp.medium.emission.kind);
-    }
+    const int emits = emission_emits(sp.medium.emission.kind);
+    if (emits < 0) throw unknownKind("emission", sp.medium.emission.kind);
+    if (emits > 0) add("-DEMISSION");
   }
   // One kind for every light: fixed at build time (no light at all: nothing to fix).
   std::string lightKind;

@@ -1,5 +1,6 @@
 /* emission.h: emissive media, pbrt-v4's model (DESIGN.md "Emission"): the medium emits σa(x)·Le(x)
- * per unit length, so the radiance equation along a ray gains ∫ T(t) σa(t) Le(t) dt. Le is
+ * per unit length, so the radiance equation along a ray gains ∫ T(t) σa(t) Le(t) dt. Le is, by
+ * kind (emission_kinds.h),
  *   EMISSION_COLOR      colour · scale · v(x)           (v: the emission grid, e.g. EmberGen's
  *                                                        `flames`; 1 without a grid)
  *   EMISSION_BLACKBODY  scale · B((v(x) − offset) · s)  (v: a temperature grid; pbrt-v4's

@@ -23,10 +23,10 @@ static inline vec3 light_rectangle_area_point(NV_CONSTANT const light_params* l,
  * Le·(A/K²)·max(0, cos θ_j) towards x (the midpoint rule over the area, as the path tracer's area
  * light integrates exactly). Why not the centre alone (K = 1, light_view_from): with a
  * forward-peaked phase function the phase angle changes across the light by more than the lobe's
- * width (HG(0.8) halves within 10°; a 6-unit light 20 units away spans 17°). With the centre for
- * both phase and shadow, single scattering on the default cloud at g 0.8 sums to 0.68 of the path
- * tracer's (0.999 at g 0); 4x4 points for the phase bring it to 0.74, and the shadow averaged over
- * them as well (march_light_column, the callers' shadow) to 0.82. */
+ * width (HG(0.8) halves within 10°; a 6-unit light 20 units away spans 17°): the centre for both
+ * phase and shadow loses much of the single scattering at g 0.8, and K×K points for the phase and
+ * the shadow (march_light_column) recover most of it (bench/RESULTS.md, "Rectangle lights as K×K
+ * points"). */
 static inline vec3 light_rectangle_phase_sum(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                          vec3 view_dir, int K) {
   const vec3 Le = vec3_from4(l->radiance);
@@ -52,8 +52,7 @@ static inline vec3 light_rectangle_phase_sum(NV_CONSTANT const light_params* l, 
  * its size. Why: at g 0.9 HG falls to half its peak within 5°, and Listing 4.1's light (150x100
  * units, 80 behind the Disney cloud) spans 86°x64° from it: its centre alone paints a bright disc
  * wherever the view ray points at it (the phase's peak) and misses the rest (the back-lit Disney
- * cloud with the multiple-scattering cache: relMSE 1.88 against the path tracer with the centre,
- * 0.09 exact; bench/RESULTS.md); K×K points paint K² discs. */
+ * cloud with the multiple-scattering cache, bench/RESULTS.md); K×K points paint K² discs. */
 static inline vec3 light_rectangle_phase_integral(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                               vec3 view_dir) {
   const vec3 c = vec3_from4(l->corner), u = vec3_from4(l->edge_u), v = vec3_from4(l->edge_v);
@@ -81,7 +80,7 @@ static inline float march_mean_column(float w_sum, float loss_sum, float column_
  * shadow vary together. They do behind a cloud lit from the back: at g 0.9 the phase is a peak a
  * few degrees wide around the view ray's continuation, the shadow along it is the thin rim's, and
  * an average over the light's area (the other weighting) takes in directions through the cloud's
- * body (bench/RESULTS.md: the back-lit Disney cloud's rim 25% dark, its core 3x bright). Both
+ * body (bench/RESULTS.md: the back-lit Disney cloud's rim too dark, its core too bright). Both
  * integrals are estimated by two strategies combined with the balance heuristic (Veach 1997,
  * ch. 9): the K×K points of light_rectangle_area_point (the area's midpoint rule: a solid-angle pdf of
  * d²/(A·cos θ_l)), and K×K directions drawn from the phase function about view_dir on a regular

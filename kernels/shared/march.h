@@ -1,11 +1,10 @@
-/* march.h: deterministic quadrature shared by the real-time kernels (raymarch.cl, lobe.cl).
- * Transmittance by midpoint sampling with true step lengths, all three channels (DESIGN.md:
- * "every step uses its true length"), and lights as points: a rectangle becomes a point at its
- * centre with intensity Le·A·max(0, cos θ_light), the approximation DESIGN.md allows for these
- * kernels (the path tracer always integrates the true area light).
- * Empty space: a march places its samples only in majorant cells whose density bound is above 0
- * (majorant.h DDA), spread evenly over their total length, so time follows the medium, not the box;
- * the skipped cells have density exactly 0 there, so skipping them changes nothing but the spacing. */
+/* march.h: what the real-time kernels (raymarch.cl, lobe.cl) take from the lights and the view:
+ * the medium's own light along a view segment, a light's in-scattering and shadow column (any
+ * light as its one point, light_view_from; an area light over K×K points of it or its exact
+ * solid angle, light_rectangle_area.h: the approximation DESIGN.md allows for these kernels, the
+ * path tracer always integrating the true light), and the view ray's background and segment.
+ * The quadrature itself (true step lengths, samples only in occupied majorant cells) is
+ * march_quadrature.h's. */
 #ifndef NARVAL_MARCH_H
 #define NARVAL_MARCH_H
 

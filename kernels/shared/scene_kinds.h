@@ -12,16 +12,11 @@ static inline uint scene_kinds_status(NV_CONSTANT const scene_params* s, NV_CONS
   uint status = 0u;
   if (s->has_medium) {
     if (!phase_known(s->medium.phase.kind)) status |= STATUS_UNKNOWN_KIND;
-    switch (s->medium.emission.kind) {
-      case EMISSION_NONE: break;
-      case EMISSION_COLOR:
-      case EMISSION_BLACKBODY:
+    const int emits = emission_emits(s->medium.emission.kind);
+    if (emits < 0) status |= STATUS_UNKNOWN_KIND;
 #ifndef EMISSION
-        status |= STATUS_UNKNOWN_KIND; /* an emitting medium in a kernel built without emission */
+    if (emits > 0) status |= STATUS_UNKNOWN_KIND; /* an emitting medium in a kernel built without emission */
 #endif
-        break;
-      default: status |= STATUS_UNKNOWN_KIND;
-    }
   }
   switch (s->light_sampling) {
     case LIGHT_SAMPLING_ALL:

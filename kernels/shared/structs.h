@@ -4,6 +4,7 @@
 #ifndef NARVAL_STRUCTS_H
 #define NARVAL_STRUCTS_H
 
+#include "shared/emission_kinds.h"
 #include "shared/light_kinds.h"
 #include "shared/phase_kinds.h"
 #include "shared/vec3.h"
@@ -64,11 +65,6 @@ typedef struct majorant_grid_params {
   int pad0;
 } majorant_grid_params;
 
-/* Emission kinds (emission_params.kind; kernels/shared/emission.h). */
-#define EMISSION_NONE 0
-#define EMISSION_COLOR 1     /* Le = color · v: v the emission grid's value, or 1 without a grid */
-#define EMISSION_BLACKBODY 2 /* Le = color · B((v − temperature_offset) · temperature_scale) */
-
 /* Emission of the medium (pbrt-v4's model: σa(x)·Le(x) per unit length). The emission grid has an
  * index space of its own (its own transform and bounding box in the file); index_to_grid maps the
  * medium's index space into it. B is the blackbody table (host/render/blackbody.h): table_size
@@ -81,7 +77,7 @@ typedef struct emission_params {
   float temperature_scale;
   float table_max;         /* kelvin of the table's last entry */
   int table_size;          /* entries (rgb triples) in the table */
-  int kind;                /* EMISSION_NONE, EMISSION_COLOR or EMISSION_BLACKBODY */
+  int kind;                /* emission_kinds.h */
   int pad0, pad1, pad2;
 } emission_params;
 
