@@ -40,4 +40,10 @@ static inline ray3 camera_ray(NV_CONSTANT const camera_params* c, float px, floa
   return r;
 }
 
+/* The real-time kernels' ray of pixel (px, py): through its centre, from the lens's centre (they
+ * are deterministic: no jitter, no depth of field). */
+static inline ray3 camera_pixel_centre_ray(NV_CONSTANT const camera_params* c, int px, int py) {
+  return camera_ray(c, (float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f);
+}
+
 #endif

@@ -101,20 +101,12 @@
 #ifndef NARVAL_LOBE_H
 #define NARVAL_LOBE_H
 
+#include "shared/camera.h"
 #include "shared/light_cache.h"
 #include "shared/phase.h"
 
 /* Halvings of the first-hit step: x0 is placed within Δ/64 past the density's zero crossing. */
 #define LOBE_BISECTIONS 6
-
-/* The pinhole primary ray through image point (px, py) (pixel units, (0,0) the top-left corner):
- * camera.h's mapping without the thin lens (DESIGN.md: the real-time kernels are pinhole). */
-static inline vec3 lobe_view_dir(NV_CONSTANT const camera_params* c, float px, float py) {
-  const float sx = (2.0f * px / (float)c->width - 1.0f) * c->tan_half_vfov * c->aspect;
-  const float sy = (1.0f - 2.0f * py / (float)c->height) * c->tan_half_vfov;
-  const vec3 fwd = vec3_from4(c->forward), right = vec3_from4(c->right), up = vec3_from4(c->up);
-  return vec3_normalize(vec3_add(fwd, vec3_add(vec3_scale(right, sx), vec3_scale(up, sy))));
-}
 
 /* First parameter in [seg.t0, seg.t1] where the density is above zero; 0 when there is none. The
  * search samples the occupied cells only (march_iter), then bisects between the last empty sample
@@ -378,15 +370,9 @@ static inline vec3 lobe_pixel(KERNEL_CONTEXT_PARAM,
                               NV_GLOBAL const float* light_cache, int px, int py) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
-  NV_CONSTANT const camera_params* cam = &s->camera;
-  const vec3 dir = lobe_view_dir(cam, (float)px + 0.5f, (float)py + 0.5f);
-  const vec3 L =
-      lobe_radiance(KERNEL_CONTEXT_ARG, p, dirs, light_cache, vec3_from4(cam->position), dir, vec3_from4(cam->right));
-  if (!vec3_is_finite(L)) {
-    *status |= STATUS_NAN;
-    return vec3_splat(0.0f);
-  }
-  return L;
+  const ray3 r = camera_pixel_centre_ray(&s->camera, px, py);
+  return status_finite_or_zero(
+      status, lobe_radiance(KERNEL_CONTEXT_ARG, p, dirs, light_cache, r.origin, r.dir, vec3_from4(s->camera.right)));
 }
 
 #endif

@@ -105,11 +105,7 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtim
   if (direct) L = pathtrace_direct_at(KERNEL_CONTEXT_ARG, x, vec3_scale(w_c, -1.0f), u[1], u[4], u[5], gd, &rng);
   L = vec3_add(L, vec3_scale(pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, direct ? pdf : 0.0f, &rng),
                              weight));
-  if (!vec3_is_finite(L)) {
-    *status |= STATUS_NAN;
-    return vec3_splat(0.0f);
-  }
-  return L;
+  return status_finite_or_zero(status, L);
 }
 
 /* Whether a lookup can read node `node`. The march looks the cache up only at samples of positive

@@ -220,11 +220,7 @@ static inline vec3 pathtrace_sample(KERNEL_CONTEXT_PARAM, int px, int py, uint s
   const float lu = rng_uniform(&rng), lv = rng_uniform(&rng);
   const ray3 cam = camera_ray(&s->camera, (float)px + jx, (float)py + jy, lu, lv);
   const vec3 L = pathtrace_radiance(KERNEL_CONTEXT_ARG, cam.origin, cam.dir, 1, 0.0f, &rng);
-  if (!vec3_is_finite(L)) {
-    *status |= STATUS_NAN;
-    return vec3_splat(0.0f);
-  }
-  return L;
+  return status_finite_or_zero(status, L);
 }
 
 #endif

@@ -202,7 +202,7 @@ static inline vec3 raymarch_pixel(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realti
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
   NV_PRIVATE uint* status = &ctx->status;
-  const ray3 r = camera_ray(&s->camera, (float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f);
+  const ray3 r = camera_pixel_centre_ray(&s->camera, px, py);
   const vec3 Lb = march_background(s, lights, r.origin, r.dir);
   vec3 L = Lb;
   if (s->has_medium) {
@@ -218,11 +218,7 @@ static inline vec3 raymarch_pixel(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realti
       L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
     }
   }
-  if (!vec3_is_finite(L)) {
-    *status |= STATUS_NAN;
-    return vec3_splat(0.0f);
-  }
-  return L;
+  return status_finite_or_zero(status, L);
 }
 
 #endif

@@ -22,6 +22,14 @@
  * validates kinds before uploading, so this means a host and kernels out of step. */
 #define STATUS_UNKNOWN_KIND 8u
 
+/* What a kernel keeps of an estimate (a pixel, a path, a cache node): L when finite, else 0 with
+ * STATUS_NAN raised, so one bad sample is reported instead of spreading. */
+static inline vec3 status_finite_or_zero(NV_PRIVATE uint* status, vec3 L) {
+  if (vec3_is_finite(L)) return L;
+  *status |= STATUS_NAN;
+  return vec3_splat(0.0f);
+}
+
 /* Pinhole or thin-lens camera. Pixel (0,0) is the top-left corner of the image. */
 typedef struct camera_params {
   nv_float4 position;
