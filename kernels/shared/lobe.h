@@ -51,7 +51,7 @@
  * so the value used is in [Tr_true, ε') and each of the n terms is off by less than ε':
  * |ΔL| < ε'·L_b ≤ ε per channel (raymarch.h says why ε is scaled by L_b).
  * No medium, a ray that misses the box (or meets a rectangle light first), or no density > 0 on the
- * segment: L = L_b exactly (march_background). Means divide by n (not multiply by 1/n), so n
+ * segment: L = L_b exactly (march_view). Means divide by n (not multiply by 1/n), so n
  * transmittances of exactly 1 give exactly L_b.
  * Loops: the first-hit search (`steps` samples, then LOBE_BISECTIONS), n lobe points × (one march of
  * view_steps + lights × (one cache lookup or a march of shadow_steps)): all bounded by the scene's
@@ -341,11 +341,10 @@ static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtim
                                  NV_GLOBAL const float* light_cache, vec3 origin, vec3 dir, vec3 right) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
-  /* L_b, and the view ray stops at the first rectangle it meets (rectangles are opaque). */
-  const vec3 Lb = march_background(s, lights, origin, dir);
-  if (!s->has_medium || p->lobe_points < 1) return Lb;
+  /* L_b, and the view ray stops at the first light surface it meets (they are opaque). */
+  vec3 Lb;
   medium_segment seg;
-  if (!march_view_segment(s, lights, origin, dir, &seg)) return Lb;
+  if (!march_view(s, lights, origin, dir, &Lb, &seg) || p->lobe_points < 1) return Lb;
 
   /* 3. Frame (t, b, ω) from the camera's right vector; (t, b, ω) is right-handed. */
   vec3 tx, ty;

@@ -99,29 +99,23 @@ static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const l
   return march_column_density(KERNEL_CONTEXT_ARG, x, dir, d, shadow_steps);
 }
 
-/* L_b for the real-time kernels: what the view ray would see with the medium removed, i.e. the
- * front of the nearest light surface it hits (black from behind), else the background and the
- * lights at infinity along it. */
-static inline vec3 march_background(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                    vec3 origin, vec3 dir) {
-  float t;
-  int front = 0;
-  const int hit = light_hit_nearest(lights, s->num_lights, origin, dir, 0.0f, -1, &t, &front);
-  if (hit >= 0) return front ? vec3_from4(lights[hit].radiance) : vec3_splat(0.0f);
-  vec3 Lb = vec3_from4(s->background); /* and the lights at infinity seen along dir */
-  for (int i = 0; i < s->num_lights; ++i) Lb = vec3_add(Lb, light_escaped(&lights[i], dir));
-  return Lb;
-}
-
-/* The view ray's segment through the medium's box into *seg, stopped at the first rectangle light it
- * meets (the medium behind an emitter is hidden by it: the path tracer's rule); 0 when there is none.
- * The real-time kernels' view rays and the view-space cache's columns (ms_cache_view.h) start here. */
-static inline int march_view_segment(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights,
-                                     vec3 origin, vec3 dir, NV_PRIVATE medium_segment* seg) {
+/* A view ray's start, for the real-time kernels and the view cache's columns (ms_cache_view.h):
+ * *Lb, what the ray would see with the medium removed (the front of the nearest light surface it
+ * hits, black from behind, else the background and the lights at infinity along it), and into *seg
+ * its segment through the medium's box, stopped at that surface (the medium behind an emitter is
+ * hidden by it: the path tracer's rule). Returns 0 when no medium lies on it. */
+static inline int march_view(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights, vec3 origin,
+                             vec3 dir, NV_PRIVATE vec3* Lb, NV_PRIVATE medium_segment* seg) {
   float t_surf;
   int front = 0;
-  light_hit_nearest(lights, s->num_lights, origin, dir, 0.0f, -1, &t_surf, &front);
-  return medium_intersect(&s->medium, origin, dir, 0.0f, t_surf, seg);
+  const int hit = light_hit_nearest(lights, s->num_lights, origin, dir, 0.0f, -1, &t_surf, &front);
+  if (hit >= 0) {
+    *Lb = front ? vec3_from4(lights[hit].radiance) : vec3_splat(0.0f);
+  } else {
+    *Lb = vec3_from4(s->background);
+    for (int i = 0; i < s->num_lights; ++i) *Lb = vec3_add(*Lb, light_escaped(&lights[i], dir));
+  }
+  return s->has_medium && medium_intersect(&s->medium, origin, dir, 0.0f, t_surf, seg);
 }
 
 #endif

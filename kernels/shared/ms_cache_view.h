@@ -120,13 +120,14 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
     v[MS_VIEW_T] = v[MS_VIEW_T_END] = v[MS_VIEW_BUDGET] = v[MS_VIEW_SEEN] = 0.0f;
   }
   medium_segment seg;
-  if (!s->has_medium || !march_view_segment(s, ctx->lights, r.origin, r.dir, &seg)) return;
+  vec3 Lb;
+  if (!march_view(s, ctx->lights, r.origin, r.dir, &Lb, &seg)) return;
   const float sigma = ms_view_sigma_t(&s->medium);
   /* First march: τ_end, the column over the same samples as the second (the segment [t0, t1] again). */
   const float total = sigma * march_column_density(KERNEL_CONTEXT_ARG, r.origin, r.dir, seg.t1, MS_VIEW_PLACE_STEPS);
   if (!(total > 0.0f)) return;
   const float t_end = nv_fmax(nv_exp(-total), MS_VIEW_T_MIN);
-  cache[MS_VIEW_SEEN] = t_end * vec3_average(march_background(s, ctx->lights, r.origin, r.dir));
+  cache[MS_VIEW_SEEN] = t_end * vec3_average(Lb);
   /* Second march: where τ(t), linear over each step, reaches each level in turn; levels it does not
    * reach (rounding, or past τ_max) lie at the end of the last step with medium. */
   int i = 0;
@@ -156,7 +157,8 @@ static inline vec3 ms_view_sample_point(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
   NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
   const ray3 r = ms_view_column_ray(&s->camera, rp->ms_cache_tile, node % c->nx, (node / c->nx) % c->ny);
   medium_segment seg;
-  if (!march_view_segment(s, ctx->lights, r.origin, r.dir, &seg)) return vec3_madd(r.origin, r.dir, v[MS_VIEW_T]);
+  vec3 Lb;
+  if (!march_view(s, ctx->lights, r.origin, r.dir, &Lb, &seg)) return vec3_madd(r.origin, r.dir, v[MS_VIEW_T]);
   seg.t0 = v[MS_VIEW_T];
   seg.t1 = v[MS_VIEW_T_END];
   const float T0 = nv_exp(-v[MS_VIEW_TAU]), T1 = nv_exp(-v[MS_VIEW_TAU_END]);

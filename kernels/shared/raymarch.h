@@ -17,7 +17,7 @@
  *   S_k = σs(x_k) ⊙ Σ_lights (I/d²) ⊙ Σ_{i<N} aⁱ · p(g·cⁱ, μ) · exp(−bⁱ·τ(x_k → light))
  *   L  += T ⊙ (S_k − S_k ⊙ e^{−σt(x_k)·Δ}) / σt(x_k)      (energy-conserving step, exact for
  *   T  ⊙= e^{−σt(x_k)·Δ}                                     S and σt constant over the step)
- * and the pixel is L + T ⊙ L_b (L_b: march_background, what the ray sees with the medium removed).
+ * and the pixel is L + T ⊙ L_b (L_b: march_view, what the ray sees with the medium removed).
  * Lights are points (light_view_from: a rectangle is a point at its centre with intensity
  * Le·A·max(0, cos θ_light), the approximation DESIGN.md allows here) unless area_light_samples
  * K > 1 (the phase and 1/d² over K×K points of a rectangle) or area_light_phase is AREA_LIGHT_EXACT
@@ -203,20 +203,20 @@ static inline vec3 raymarch_pixel(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realti
   NV_CONSTANT const light_params* lights = ctx->lights;
   NV_PRIVATE uint* status = &ctx->status;
   const ray3 r = camera_pixel_centre_ray(&s->camera, px, py);
-  const vec3 Lb = march_background(s, lights, r.origin, r.dir);
-  vec3 L = Lb;
-  if (s->has_medium) {
-    medium_segment seg;
-    if (march_view_segment(s, lights, r.origin, r.dir, &seg)) {
-      raymarch_accum acc;
-      acc.L = vec3_splat(0.0f);
-      acc.T = vec3_splat(1.0f);
-      const float t_stop = rp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb));
-      const ms_view_columns cols = ms_view_locate(rp, px, py);
-      raymarch_segment(KERNEL_CONTEXT_ARG, rp, light_cache, ms_cache, &seg, &cols, r.origin, r.dir, rp->steps, t_stop,
-                       &acc);
-      L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
-    }
+  vec3 Lb;
+  medium_segment seg;
+  vec3 L;
+  if (march_view(s, lights, r.origin, r.dir, &Lb, &seg)) {
+    raymarch_accum acc;
+    acc.L = vec3_splat(0.0f);
+    acc.T = vec3_splat(1.0f);
+    const float t_stop = rp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb));
+    const ms_view_columns cols = ms_view_locate(rp, px, py);
+    raymarch_segment(KERNEL_CONTEXT_ARG, rp, light_cache, ms_cache, &seg, &cols, r.origin, r.dir, rp->steps, t_stop,
+                     &acc);
+    L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
+  } else {
+    L = Lb;
   }
   return status_finite_or_zero(status, L);
 }
