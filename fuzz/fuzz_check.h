@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 namespace narval::fuzz {
 

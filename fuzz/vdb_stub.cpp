@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 

@@ -20,7 +20,7 @@
 #include <string>
 
 #include "fuzz_check.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace {
 

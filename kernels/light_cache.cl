@@ -4,17 +4,15 @@
 #include "shared/scene_kinds.h"
 #include "shared/light_cache.h"
 
-__kernel void light_cache_build(KERNEL_SCENE_ARGS,
-                                __constant realtime_params* params, int light, __global float* cache,
-                                __global uint* status_word) {
+__kernel void light_cache_build(KERNEL_SCENE_ARGS, march_params march, node_grid_params light_cache, int light,
+                                __global float* cache, __global uint* status_word) {
   const int node = get_global_id(0);
-  __constant node_grid_params* c = &params->light_cache;
-  const int nodes = node_grid_count(c);
+  const int nodes = node_grid_count(&light_cache);
   if (node >= nodes) return;
   KERNEL_CONTEXT_BEGIN(ctx);
-  ctx.status = scene_kinds_status(scene, lights); /* unknown kinds: STATUS_UNKNOWN_KIND */
-  cache[(size_t)light * (size_t)nodes + (size_t)node] = light_cache_build_node(
-      KERNEL_ENTRY_ARG(ctx), c, params->shadow_steps, params->shadow_area_samples, params->shadow_weighting,
-      &lights[light], node);
+  ctx.status = scene_kinds_status(scene, lights) | march_kinds_status(&march); /* STATUS_UNKNOWN_KIND */
+  cache[(size_t)light * (size_t)nodes + (size_t)node] =
+      light_cache_build_node(KERNEL_ENTRY_ARG(ctx), &light_cache, march.shadow_steps, march.shadow_area_samples,
+                             march.shadow_weighting, &lights[light], node);
   if (ctx.status) atomic_or(status_word, ctx.status);
 }

@@ -6,28 +6,25 @@
 #include "shared/ms_cache_build.h"
 #include "shared/ms_cache_filter.h"
 
-__kernel void ms_cache_build(KERNEL_SCENE_ARGS,
-                             __constant realtime_params* params, uint first, uint count, __global float* cache,
-                             __global uint* status_word) {
+__kernel void ms_cache_build(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, uint first, uint count,
+                             __global float* cache, __global uint* status_word) {
   const int node = get_global_id(0);
-  __constant node_grid_params* c = &params->ms_cache;
-  if (node >= node_grid_count(c)) return;
+  if (node >= node_grid_count(&ms_cache.grid)) return;
   KERNEL_CONTEXT_BEGIN(ctx);
-  ctx.status = scene_kinds_status(scene, lights) | realtime_kinds_status(params); /* STATUS_UNKNOWN_KIND */
-  ms_cache_build_node(KERNEL_ENTRY_ARG(ctx), params, node, cache + (size_t)node * MS_CACHE_STRIDE, first, count);
+  ctx.status = scene_kinds_status(scene, lights) | ms_cache_kinds_status(&ms_cache); /* STATUS_UNKNOWN_KIND */
+  ms_cache_build_node(KERNEL_ENTRY_ARG(ctx), &ms_cache, node, cache + (size_t)node * MS_CACHE_STRIDE, first, count);
   if (ctx.status) atomic_or(status_word, ctx.status);
 }
 
 /* The view layout's placement (ms_cache_view.h, ms_view_place_column): one work-item per column,
  * run once when the cache starts over, before ms_cache_build. */
-__kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, __constant realtime_params* params, __global float* cache,
+__kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, __global float* cache,
                                   __global uint* status_word) {
   const int column = get_global_id(0);
-  __constant node_grid_params* c = &params->ms_cache;
-  if (column >= c->nx * c->ny) return;
+  if (column >= ms_cache.grid.nx * ms_cache.grid.ny) return;
   KERNEL_CONTEXT_BEGIN(ctx);
-  ctx.status = scene_kinds_status(scene, lights) | realtime_kinds_status(params); /* STATUS_UNKNOWN_KIND */
-  ms_view_place_column(KERNEL_ENTRY_ARG(ctx), params, column, cache + (size_t)column * MS_CACHE_STRIDE);
+  ctx.status = scene_kinds_status(scene, lights) | ms_cache_kinds_status(&ms_cache); /* STATUS_UNKNOWN_KIND */
+  ms_view_place_column(KERNEL_ENTRY_ARG(ctx), &ms_cache, column, cache + (size_t)column * MS_CACHE_STRIDE);
   if (ctx.status) atomic_or(status_word, ctx.status);
 }
 
@@ -35,11 +32,10 @@ __kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, __constant realtime_params*
  * ms_cache_build launch; `filtered` (the cache's layout, a copy of each node with its R filtered)
  * is what the march reads. The weights from `cache`, the values from `values`: the cache itself,
  * or with `residual` 1 the first pass's output, for twicing's second pass. */
-__kernel void ms_cache_filter_view(__constant realtime_params* params, __global const float* cache,
+__kernel void ms_cache_filter_view(ms_cache_params ms_cache, __global const float* cache,
                                    __global const float* values, int residual, __global float* filtered) {
   const int column = get_global_id(0);
-  __constant node_grid_params* c = &params->ms_cache;
-  if (column >= c->nx * c->ny) return;
-  ms_view_filter_column(c, cache, values, residual, column, params->ms_cache_filter,
-                        params->ms_cache_filter_tolerance, filtered + (size_t)column * MS_CACHE_STRIDE);
+  if (column >= ms_cache.grid.nx * ms_cache.grid.ny) return;
+  ms_view_filter_column(&ms_cache.grid, cache, values, residual, column, ms_cache.filter, ms_cache.filter_tolerance,
+                        filtered + (size_t)column * MS_CACHE_STRIDE);
 }

@@ -17,7 +17,7 @@
 #include <utility>
 #include <vector>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 // A device test on a machine without an OpenCL device skips, saying so; with NARVAL_REQUIRE_DEVICE=1
 // (CI sets it) a missing device fails instead, so a broken PoCL install cannot turn the device tests

@@ -24,11 +24,11 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli_common.h"
+#include "core/input_error.h"
 #include "image/image.h"
 #include "native/native_render.h"
 #include "render/lobe_directions.h"
 #include "render/realtime_renderer.h"
-#include "scene/input_error.h"
 
 #ifndef NARVAL_NATIVE_FLAGS
 #define NARVAL_NATIVE_FLAGS "unknown"

@@ -53,7 +53,7 @@ static inline float native_fmaxf(float a, float b) { return (a > b || b != b) ? 
 
 #include "image/image.h"
 #include "render/accumulator.h"
-#include "render/light_cache.h"
+#include "render/device_light_cache.h"
 #include "render/lobe_directions.h"
 #include "render/realtime_renderer.h"
 #include "render/render_common.h"
@@ -70,8 +70,8 @@ struct NativeOptions {
   int threads = 0;                      // 0: std::thread::hardware_concurrency()
   std::string majorant = "grid";        // pathtrace: grid | global (as narval render --majorant)
   int spp = 1;                          // pathtrace samples per pixel
-  realtime_params realtime{};           // raymarch / lobe (realtimeParams(scene))
-  std::vector<float> lightCache;        // raymarch / lobe with realtime.light_cache.nx > 0: the
+  RealtimeParams realtime;              // raymarch / lobe (realtimeParams(scene))
+  std::vector<float> lightCache;        // raymarch / lobe with realtime.lightCache.nx > 0: the
                                         // cache's slabs (buildLightCacheOnHost)
   std::vector<float> msCache;           // stays empty: the multiple-scattering cache is device-only
                                         // (prepareRealtimeInputs refuses it), so never read
@@ -109,13 +109,15 @@ inline grid_view nativeGridView(const DeviceScene& ds, const NativeOptions& o) {
 // directions and the light cache's slabs, for o.algorithm (nothing for pathtrace).
 inline void prepareRealtimeInputs(const Scene& scene, const DeviceScene& ds, NativeOptions& o) {
   if (!isRealtime(o.algorithm)) return;
-  o.realtime = realtimeParams(scene, ds);
-  if (o.algorithm == Algorithm::Lobe) o.lobeDirections = lobeDirections(o.realtime.lobe_points, ds.params, scene.renderer.seed);
-  if (o.realtime.ms_cache.nx > 0)
+  Scene asked = scene;  // the blocks of o.algorithm, whatever the scene names
+  asked.renderer.algorithm = o.algorithm;
+  o.realtime = realtimeParams(asked, ds);
+  if (o.algorithm == Algorithm::Lobe) o.lobeDirections = lobeDirections(o.realtime.lobe.points, ds.params, scene.renderer.seed);
+  if (o.realtime.msCache.grid.nx > 0)
     throw std::invalid_argument("narval-native: the multiple-scattering cache is built on OpenCL devices only");
-  if (o.realtime.light_cache.nx > 0) {
+  if (o.realtime.lightCache.nx > 0) {
     const grid_view gv = nativeGridView(ds, o);
-    o.lightCache = buildLightCacheOnHost(ds, &gv, o.realtime);
+    o.lightCache = buildLightCacheOnHost(ds, &gv, o.realtime.march, o.realtime.lightCache);
   }
 }
 
@@ -127,7 +129,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
     throw std::invalid_argument("renderNative: majorant must be grid or global, got '" + o.majorant + "'");
   if (alg == Algorithm::Lobe && o.lobeDirections.empty())
     throw std::invalid_argument("renderNative: lobe needs its directions");
-  if (isRealtime(alg) && o.realtime.light_cache.nx > 0 && o.lightCache.empty())
+  if (isRealtime(alg) && o.realtime.lightCache.nx > 0 && o.lightCache.empty())
     throw std::invalid_argument("renderNative: the light cache is on but was not built");
   const scene_params* sp = &ds.params;
   const light_params* lights = ds.lights.data();
@@ -135,7 +137,7 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
   const int spp = std::max(1, o.spp);
   const grid_view gv = nativeGridView(ds, o);
   const grid_view* grid = &gv;
-  const realtime_params* rp = &o.realtime;
+  const RealtimeParams* rp = &o.realtime;
   const nv_float4* dirs = o.lobeDirections.data();
   const float* cache = o.lightCache.data();
 
@@ -162,9 +164,9 @@ inline NativeResult renderNative(const DeviceScene& ds, const NativeOptions& o) 
             break;
           }
           case Algorithm::Raymarch:
-            L = raymarch_pixel(&ctx, rp, cache, o.msCache.data(), x, y);
+            L = raymarch_pixel(&ctx, &rp->march, &rp->lightCache, &rp->msCache, cache, o.msCache.data(), x, y);
             break;
-          case Algorithm::Lobe: L = lobe_pixel(&ctx, rp, dirs, cache, x, y); break;
+          case Algorithm::Lobe: L = lobe_pixel(&ctx, &rp->march, &rp->lobe, &rp->lightCache, dirs, cache, x, y); break;
         }
         row[size_t(x) * 4 + 0] = L.x;
         row[size_t(x) * 4 + 1] = L.y;

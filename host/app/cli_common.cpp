@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <regex>
 
-#include "image/atomic_file.h"
-#include "scene/input_error.h"
+#include "core/atomic_file.h"
+#include "core/input_error.h"
 
 namespace narval {
 

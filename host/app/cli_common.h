@@ -8,10 +8,10 @@
 #include <CLI/CLI.hpp>
 
 #include "cl/cl_runtime.h"
-#include "image/atomic_file.h"  // writeTextAtomic
+#include "core/atomic_file.h"  // writeTextAtomic
 #include "render/scene_grids.h"  // loadSceneGrids
 #include "scene/scene.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 

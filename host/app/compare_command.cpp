@@ -1,7 +1,7 @@
 // compare_command.cpp: `narval compare REF.exr TEST.exr` (DESIGN.md, Perceptual metric): mean,
 // 95th percentile and max of ΔE76 and ΔE2000 and the JND% (ΔE > 2.3) of each, as a table or as JSON;
 // optionally the ΔE76 heat map and the JND map as PNGs, and the floor the reference's own noise puts
-// under the JND% (--reference-snapshot, render/reference_noise.h).
+// under the JND% (--reference-snapshot, host/analysis/reference_noise.h).
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -14,12 +14,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "analysis/image_compare.h"
+#include "analysis/reference_noise.h"
 #include "app/cli_common.h"
 #include "app/commands.h"
+#include "core/input_error.h"
+#include "core/number_format.h"
 #include "image/image.h"
-#include "image/image_compare.h"
-#include "render/reference_noise.h"
-#include "scene/input_error.h"
 
 namespace fs = std::filesystem;
 
@@ -67,11 +68,6 @@ void checkPngOutput(const std::string& path, const std::string& option) {
   if (ext != ".png") throw inputError(option, "", "the output must be a .png file, got '" + path + "'");
 }
 
-std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
 
 std::string tableRow(const char* name, const DeltaEStats& s) {
   char buf[160];
@@ -123,36 +119,24 @@ int runCompare(const CompareArgs& a) {
   }
 
   if (a.json) {
-    nlohmann::ordered_json j = {{"reference", a.reference},
-                                {"test", a.test},
-                                {"width", c.width},
-                                {"height", c.height},
-                                {"exposure", exposure},
-                                {"tonemap", toneMappingName(toneMapping)},
-                                {"display_transform", source},
-                                {"mean_dE76", c.stats76.mean},
-                                {"p95_dE76", c.stats76.p95},
-                                {"max_dE76", c.stats76.max},
-                                {"jnd76_pct", c.stats76.jndPercent},
-                                {"mean_dE2000", c.stats2000.mean},
-                                {"p95_dE2000", c.stats2000.p95},
-                                {"max_dE2000", c.stats2000.max},
-                                {"jnd2000_pct", c.stats2000.jndPercent},
-                                {"rel_mse", c.relMse}};
-    if (floor)
-      j["reference_noise"] = {{"snapshot", a.snapshot},
-                              {"snapshot_spp", noise->snapshotSamples},
-                              {"reference_spp", noise->referenceSamples},
-                              {"mean_dE76", floor->stats76.mean},
-                              {"jnd76_pct", floor->stats76.jndPercent},
-                              {"mean_dE2000", floor->stats2000.mean},
-                              {"jnd2000_pct", floor->stats2000.jndPercent}};
+    nlohmann::ordered_json j = {{"reference", a.reference}, {"test", a.test},      {"width", c.width},
+                                {"height", c.height},       {"exposure", exposure}, {"tonemap", toneMappingName(toneMapping)},
+                                {"display_transform", source}};
+    addDeltaEJson(j, c.stats76, c.stats2000);
+    j["rel_mse"] = c.relMse;
+    if (floor) {
+      nlohmann::ordered_json n = {{"snapshot", a.snapshot},
+                                  {"snapshot_spp", noise->snapshotSamples},
+                                  {"reference_spp", noise->referenceSamples}};
+      addDeltaEJson(n, floor->stats76, floor->stats2000);
+      j["reference_noise"] = n;
+    }
     std::cout << j.dump(2) << "\n";
     return 0;
   }
   std::cout << "reference " << a.reference << "\n"
             << "test      " << a.test << "\n"
-            << "          " << c.width << "x" << c.height << ", exposure " << fixed(exposure, 2)
+            << "          " << c.width << "x" << c.height << ", exposure " << formatFixed(exposure, 2)
             << " stops, tone mapping " << toneMappingName(toneMapping) << " (" << source << ")\n\n";
   char header[160];
   std::snprintf(header, sizeof header, "%-8s %10s %10s %10s %10s\n", "", "mean", "p95", "max", "JND%");
@@ -162,9 +146,9 @@ int runCompare(const CompareArgs& a) {
   if (floor)
     std::cout << "reference noise (from " << a.snapshot << ", " << noise->snapshotSamples << " of its "
               << noise->referenceSamples << " samples): a noise-free image would read about JND "
-              << fixed(floor->stats76.jndPercent, 2) << "% (dE76 mean " << fixed(floor->stats76.mean, 4) << "), "
-              << fixed(floor->stats2000.jndPercent, 2) << "% in dE2000\n";
-  if (!a.heatmap.empty()) std::cout << "wrote " << a.heatmap << " (dE76, 0 to " << fixed(a.heatmapMax, 2) << ")\n";
+              << formatFixed(floor->stats76.jndPercent, 2) << "% (dE76 mean " << formatFixed(floor->stats76.mean, 4) << "), "
+              << formatFixed(floor->stats2000.jndPercent, 2) << "% in dE2000\n";
+  if (!a.heatmap.empty()) std::cout << "wrote " << a.heatmap << " (dE76, 0 to " << formatFixed(a.heatmapMax, 2) << ")\n";
   if (!a.jndMap.empty()) std::cout << "wrote " << a.jndMap << " (dE76 > 2.3 in red)\n";
   return 0;
 }

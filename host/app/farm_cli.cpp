@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <iostream>
 
+#include "core/shell_quote.h"
 #include "farm/farm_run.h"
-#include "util/shell_quote.h"
 
 namespace fs = std::filesystem;
 

@@ -9,10 +9,10 @@
 #include "app/cli_common.h"
 #include "app/commands.h"
 #include "app/farm_cli.h"
+#include "core/input_error.h"
 #include "farm/farm_job.h"
 #include "farm/process.h"
 #include "render/render_exr.h"
-#include "scene/input_error.h"
 
 namespace fs = std::filesystem;
 

@@ -1,4 +1,4 @@
-// interrupt.h: Ctrl-C ends a long render early without losing it (issue 5). While an
+// interrupt.h: Ctrl-C ends a long render early without losing it. While an
 // InterruptWatch lives, the first SIGINT sets flag() (the render stops after the pass in flight
 // and writes the samples done; the command exits 130); the handler then returns to the default,
 // so a second Ctrl-C ends the process at once, and an atomic write never leaves a broken file.

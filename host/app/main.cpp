@@ -6,8 +6,8 @@
 
 #include "app/commands.h"
 #include "cl/cl_runtime.h"
+#include "core/input_error.h"
 #include "render/render_exr.h"
-#include "scene/input_error.h"
 
 int main(int argc, char** argv) {
   narval::recordCommandLine(argc, argv);  // for the EXRs' narval:command_line

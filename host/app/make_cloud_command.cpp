@@ -4,8 +4,8 @@
 
 #include "app/cli_common.h"
 #include "app/commands.h"
-#include "scene/input_error.h"
-#include "volume/grid.h"
+#include "core/input_error.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 

@@ -5,11 +5,11 @@
 
 #include "app/cli_common.h"
 #include "app/commands.h"
+#include "core/input_error.h"
+#include "core/staged_files.h"
 #include "image/image.h"
-#include "image/staged_files.h"
 #include "render/render_common.h"
 #include "render/render_merge.h"
-#include "scene/input_error.h"
 
 namespace fs = std::filesystem;
 

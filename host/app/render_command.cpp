@@ -12,14 +12,14 @@
 #include "app/commands.h"
 #include "app/interrupt.h"
 #include "app/progress_bar.h"
+#include "core/input_error.h"
+#include "core/staged_files.h"
 #include "display/display_server.h"
 #include "image/image.h"
-#include "image/staged_files.h"
 #include "render/pathtrace_renderer.h"
 #include "render/realtime_renderer.h"
 #include "render/render_common.h"
 #include "render/render_exr.h"
-#include "scene/input_error.h"
 #include "shared/structs.h"
 
 namespace fs = std::filesystem;
@@ -57,62 +57,6 @@ std::vector<std::string> overridesFrom(const RenderArgs& a) {
   return o;
 }
 
-nlohmann::json statsJson(const RenderStats& s, const Scene& scene) {
-  return {{"algorithm", s.algorithm},
-          {"device", s.device},
-          {"storage", s.storage},
-          {"grid_bytes", s.gridBytes},
-          {"bricks", {{"total", s.bricks}, {"occupied", s.bricksOccupied}}},
-          {"width", s.width},
-          {"height", s.height},
-          {"spp", s.spp},
-          {"sample_begin", s.sampleBegin},
-          {"spp_requested", s.sppRequested},
-          {"resumed_from_spp", s.resumedFromSpp},
-          {"interrupted", s.interrupted},
-          {"bounces", s.bounces},
-          {"seed", scene.renderer.seed},
-          {"seconds", s.seconds},
-          {"kernel_seconds", s.kernelSeconds},
-          {"build_seconds", s.buildSeconds},
-          {"samples_per_second", s.samplesPerSecond},
-          {"passes", s.passes},
-          {"nan_pixels", s.nanPixels},
-          {"program_from_cache", s.programFromCache},
-          {"majorant", s.majorant},
-          {"majorant_cells", {s.majorantCells[0], s.majorantCells[1], s.majorantCells[2]}},
-          {"light_cache_cells", {s.lightCacheCells[0], s.lightCacheCells[1], s.lightCacheCells[2]}},
-          {"light_cache_bytes", s.lightCacheBytes},
-          {"light_cache_builds", s.lightCacheBuilds},
-          {"light_cache_ms", s.lightCacheMs},
-          {"ms_cache_cells", {s.msCacheCells[0], s.msCacheCells[1], s.msCacheCells[2]}},
-          {"ms_cache_layout", s.msCacheView ? "view" : "grid"},
-          {"ms_cache_paths", s.msCachePaths},
-          {"ms_cache_builds", s.msCacheBuilds},
-          {"ms_cache_ms", s.msCacheMs},
-          {"ms_cache_filter", s.msCacheFilter},
-          {"ms_cache_filter_tolerance", s.msCacheFilterTolerance},
-          {"ms_cache_filter_twicing", s.msCacheFilterTwicing},
-          {"ms_cache_guide", s.msCacheGuide},
-          {"ms_cache_budget", {s.msCacheBudgetMin, s.msCacheBudgetMax}},
-          {"status",
-           {{"nan", (s.status & STATUS_NAN) != 0},
-            {"negative_pdf", (s.status & STATUS_NEGATIVE_PDF) != 0},
-            {"iteration_cap", (s.status & STATUS_ITERATION_CAP) != 0},
-            {"unknown_kind", (s.status & STATUS_UNKNOWN_KIND) != 0}}},
-          {"scene", scene.sourcePath}};
-}
-
-// --frames: per-frame milliseconds, the first frame (build, warm-up) apart.
-nlohmann::json framesJson(const FrameTimings& f) {
-  return {{"frames", f.count},
-          {"first_frame_ms", {{"kernel", f.firstKernelMs}, {"wall", f.firstWallMs}}},
-          {"median", f.medianKernelMs},
-          {"min", f.minKernelMs},
-          {"max", f.maxKernelMs},
-          {"wall", {{"median", f.medianWallMs}, {"min", f.minWallMs}, {"max", f.maxWallMs}}}};
-}
-
 // --resume continues with the majorant the file at `out` was rendered with (its samples depend on
 // the majorant and, for the grid, on its cells): "auto" and resolution 0 take the file's; an explicit
 // choice that differs is a usage error. Files without the attributes (older renders) are left alone.
@@ -133,62 +77,182 @@ void resumeMajorant(const std::string& out, const RenderArgs& a, std::string* ma
   *resolution = fileResolution;
 }
 
+// Flags that cannot apply to the scene's algorithm: one line each, before anything is loaded.
+// The real-time algorithms take one estimate per pixel per frame; only the ray marcher's
+// multiple-scattering cache traces paths, and it takes the scene's bounces.
+void refuseFlagsThatDoNotApply(const RenderArgs& a, const Scene& scene) {
+  if (!isRealtime(scene.renderer.algorithm)) return;
+  const std::string algorithm = algorithmName(scene.renderer.algorithm);
+  const std::string frames = "does not apply to " + algorithm + ", which renders frames (use --frames)";
+  if (a.spp >= 0) throw inputError("--spp", "", frames);
+  if (!a.samples.empty()) throw inputError("--samples", "", frames);
+  const bool cachePaths = scene.renderer.algorithm == Algorithm::Raymarch &&
+                          scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache;
+  if (a.bounces >= 0 && !cachePaths)
+    throw inputError("--bounces", "", "does not apply to " + algorithm +
+                                          " (only the ray marcher's multiple-scattering cache traces bounces)");
+  if (a.counters)
+    throw inputError("--counters", "", "only the path tracer counts collisions; the algorithm is " + algorithm);
+  if (a.resume) throw inputError("--resume", "", "only path-traced renders resume; the algorithm is " + algorithm);
+  if (a.partialEverySeconds > 0)
+    throw inputError("--write-partial-images", "", "only path-traced renders write partial images; the algorithm is " +
+                                                       algorithm);
+}
+
+// Where the render goes: OUT.exr, the PNG beside it, the statistics; each proven writable before
+// any work (folders made as the writers would make them).
+struct OutputPaths {
+  fs::path exr, png;
+  std::string statsJson;
+};
+
+OutputPaths outputPaths(const RenderArgs& a) {
+  OutputPaths o;
+  o.exr = a.out.empty() ? fs::path(fs::path(a.scene).stem().string() + ".exr") : fs::path(a.out);
+  if (o.exr.extension() != ".exr") throw inputError("-o", "", "the output must be an .exr file, got '" + a.out + "'");
+  o.png = fs::path(o.exr).replace_extension(".png");
+  o.statsJson = a.statsJson;
+  checkOutputWritable(o.exr.string(), "-o");
+  checkOutputWritable(o.png.string(), "-o");
+  checkOutputWritable(o.statsJson, "--stats-json");
+  return o;
+}
+
+// --resume: the accumulator of an earlier render of the same settings at the output path, and the
+// majorant it was rendered with.
+struct ResumePoint {
+  bool resuming = false;
+  AccumulatorState state;
+  std::string majorant;
+  int majorantResolution = 0;
+};
+
+ResumePoint resumePoint(const RenderArgs& a, const Scene& scene, const fs::path& out, int sampleBegin) {
+  ResumePoint r;
+  r.majorant = a.majorant;
+  r.majorantResolution = a.majorantResolution;
+  if (!a.resume) return r;
+  if (!fs::exists(out)) {
+    std::cerr << "narval: --resume: " << out.string() << " does not exist yet; rendering from the first sample\n";
+    return r;
+  }
+  r.state = readAccumulator(out.string(), scene, sampleBegin);
+  r.resuming = true;
+  resumeMajorant(out.string(), a, &r.majorant, &r.majorantResolution);
+  return r;
+}
+
+// Snapshots between passes: the display server's (its thread sends what changed, ~4 a second) and
+// --write-partial-images' (the EXR so far, resumable, atomically over the output), each due once
+// its interval has passed since it last took one.
+class Snapshots {
+ public:
+  // Checks --display-server's address; nothing connects yet.
+  Snapshots(const RenderArgs& a, const Scene& scene, const fs::path& out)
+      : scene_(scene), out_(out), partialEverySeconds_(a.partialEverySeconds) {
+    if (!a.displayServer.empty()) displayAt_ = parseHostPort(a.displayServer, "--display-server");
+  }
+  // Connects to the display server and starts the timers: just before the render.
+  void install(RenderOptions& options) {
+    if (displayAt_)
+      display_ = std::make_unique<DisplayServer>(*displayAt_, out_.filename().string(), scene_.renderer.width,
+                                                 scene_.renderer.height);
+    show_ = {display_ && display_->receiving(), DisplayServer::kUpdateInterval};
+    save_ = {partialEverySeconds_ > 0, std::chrono::duration<double>(partialEverySeconds_)};
+    options.snapshotDue = [this]() { return show_.due() || save_.due(); };
+    options.snapshot = [this](const RenderResult& partial) {
+      if (show_.due()) {
+        display_->post(partial.image);
+        show_.last = std::chrono::steady_clock::now();
+      }
+      if (save_.due()) {
+        writeRenderExr(out_.string(), partial, renderIdentity(scene_));
+        save_.last = std::chrono::steady_clock::now();
+      }
+    };
+  }
+  // The final image to the display, and what it has to say.
+  void finish(const RenderResult& r) {
+    if (!display_) return;
+    if (r.image.width > 0) display_->finish(r.image);
+    for (const std::string& w : display_->warnings()) std::cerr << "narval: warning: " << w << "\n";
+  }
+
+ private:
+  struct Periodic {
+    bool on = false;
+    std::chrono::duration<double> every{};
+    std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+    bool due() const { return on && std::chrono::steady_clock::now() - last >= every; }
+  };
+  const Scene& scene_;
+  fs::path out_;
+  double partialEverySeconds_;
+  std::optional<HostPort> displayAt_;
+  std::unique_ptr<DisplayServer> display_;
+  Periodic show_, save_;
+};
+
+// The EXR, the PNG and the stats land together or not at all (staged_files.h).
+void writeOutputs(const OutputPaths& o, const RenderResult& r, const Scene& scene, int frames) {
+  StagedFiles staged;
+  writeRenderExr(staged.stage(o.exr.string()), r, renderIdentity(scene));
+  writePng(staged.stage(o.png.string()), r.image, scene.renderer.exposure, scene.renderer.toneMapping);
+  if (!o.statsJson.empty()) {
+    nlohmann::json j = statsJson(r.stats, scene.renderer.seed, scene.sourcePath);
+    if (frames > 0) j["ms_per_frame"] = framesJson(r.stats.frames);
+    writeTextAtomic(staged.stage(o.statsJson), j.dump(2) + "\n");
+  }
+  staged.commit();
+}
+
+// What was written, on `report`; an interrupted render says so on stderr and exits 130.
+int reportOutcome(const RenderArgs& a, const OutputPaths& o, const RenderStats& s, bool realtime,
+                  std::ostream& report) {
+  for (const std::string& w : statusWarnings(s.status)) std::cerr << "narval: warning: " << w << "\n";
+  if (s.interrupted) {
+    std::cerr << "narval: interrupted: wrote " << o.exr.string() << " and " << o.png.string() << " with "
+              << (realtime ? std::to_string(s.passes) + " of " + std::to_string(std::max(1, a.frames)) + " frames"
+                           : std::to_string(s.spp) + " of " + std::to_string(s.sppRequested) +
+                                 " spp; --resume continues it")
+              << "\n";
+    return kExitInterrupted;
+  }
+  if (a.frames > 0)
+    report << s.algorithm << ": " << s.frames.count << " frames, first " << s.frames.firstKernelMs
+           << " ms, then median " << s.frames.medianKernelMs << " ms (min " << s.frames.minKernelMs << ", max "
+           << s.frames.maxKernelMs << ") per frame by profiling events, median " << s.frames.medianWallMs
+           << " ms by wall clock\n";
+  report << describe(s.lightCache) << describe(s.msCache);
+  report << "wrote " << o.exr.string() << " and " << o.png.string() << " (" << s.width << "x" << s.height << ", "
+         << s.algorithm << ", ";
+  if (realtime)
+    report << s.frames.count << " frame(s), " << s.frames.medianKernelMs << " ms per frame";
+  else
+    report << (a.samples.empty() ? std::to_string(s.spp) + " spp"
+                                 : "samples [" + std::to_string(s.sampleBegin) + ", " +
+                                       std::to_string(s.sampleBegin + s.spp) + ")")
+           << ", " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6 << " Msamples/s";
+  report << " on " << s.device << ")\n";
+  return 0;
+}
+
 int runRender(const RenderArgs& a) {
   std::ostream silent(nullptr);  // --quiet: report lines go nowhere (a stream without a buffer drops them)
   std::ostream& report = a.quiet ? silent : std::cout;
   Scene scene = loadScene(a.scene, overridesFrom(a));
   for (const std::string& w : scene.warnings) std::cerr << "narval: warning: " << w << "\n";
   const bool realtime = isRealtime(scene.renderer.algorithm);
-  const std::string algorithm = algorithmName(scene.renderer.algorithm);
   const auto [lx, ly] = parseSize(a.localSize, "--local-size");
-  // The real-time algorithms take one estimate per pixel per frame; only the ray marcher's
-  // multiple-scattering cache traces paths, and it takes the scene's bounces.
-  if (realtime && a.spp >= 0)
-    throw inputError("--spp", "", "does not apply to " + algorithm + ", which renders frames (use --frames)");
-  if (realtime && !a.samples.empty())
-    throw inputError("--samples", "", "does not apply to " + algorithm + ", which renders frames (use --frames)");
+  refuseFlagsThatDoNotApply(a, scene);
   const int sampleBegin = a.samples.empty() ? 0 : parseSampleRange(a.samples, "--samples").first;
-  const bool cachePaths = scene.renderer.algorithm == Algorithm::Raymarch &&
-                          scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache;
-  if (realtime && a.bounces >= 0 && !cachePaths)
-    throw inputError("--bounces", "", "does not apply to " + algorithm +
-                                          " (only the ray marcher's multiple-scattering cache traces bounces)");
-  if (a.counters && realtime)
-    throw inputError("--counters", "", "only the path tracer counts collisions; the algorithm is " + algorithm);
-
-  fs::path out = a.out.empty() ? fs::path(fs::path(a.scene).stem().string() + ".exr") : fs::path(a.out);
-  if (out.extension() != ".exr") throw inputError("-o", "", "the output must be an .exr file, got '" + a.out + "'");
-  const fs::path png = fs::path(out).replace_extension(".png");
-  // Every output is proven writable before any work (folders made as the writers would make them).
-  checkOutputWritable(out.string(), "-o");
-  checkOutputWritable(png.string(), "-o");
-  checkOutputWritable(a.statsJson, "--stats-json");
-
-  // --resume: the accumulator of an earlier render of the same settings at the output path.
-  std::string majorant = a.majorant;
-  int majorantResolution = a.majorantResolution;
-  AccumulatorState resumeState;
-  bool resuming = false;
-  if (a.resume) {
-    if (realtime) throw inputError("--resume", "", "only path-traced renders resume; the algorithm is " + algorithm);
-    if (fs::exists(out)) {
-      resumeState = readAccumulator(out.string(), scene, sampleBegin);
-      resuming = true;
-      resumeMajorant(out.string(), a, &majorant, &majorantResolution);
-      if (resumeState.samples == scene.renderer.spp) {
-        report << out.string() << " already has " << resumeState.samples << " spp; nothing to render\n";
-        return 0;
-      }
-    } else {
-      std::cerr << "narval: --resume: " << out.string() << " does not exist yet; rendering from the first sample\n";
-    }
+  const OutputPaths out = outputPaths(a);
+  const ResumePoint resume = resumePoint(a, scene, out.exr, sampleBegin);
+  if (resume.resuming && resume.state.samples == scene.renderer.spp) {
+    report << out.exr.string() << " already has " << resume.state.samples << " spp; nothing to render\n";
+    return 0;
   }
-
-  std::optional<HostPort> displayAt;
-  if (!a.displayServer.empty()) displayAt = parseHostPort(a.displayServer, "--display-server");
-  if (a.partialEverySeconds > 0 && realtime)
-    throw inputError("--write-partial-images", "", "only path-traced renders write partial images; the algorithm is " +
-                                                       algorithm);
+  Snapshots snapshots(a, scene, out.exr);
 
   // Everything the render needs is loaded and checked before the first sample.
   SceneGridStorage gridStorage;
@@ -205,114 +269,27 @@ int runRender(const RenderArgs& a) {
   options.sampleBegin = sampleBegin;
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
   options.cancel = &interrupt.flag();
-  if (resuming) options.resumeFrom = &resumeState;
+  if (resume.resuming) options.resumeFrom = &resume.state;
   // --frames with the path tracer: K passes of one sample per pixel (a frame each), K spp in all.
   if (a.frames > 0 && !realtime) {
     scene.renderer.spp = a.frames;
     options.samplesPerPass = 1;
   }
-  options.majorant = majorant;
-  options.majorantResolution = majorantResolution;
+  options.majorant = resume.majorant;
+  options.majorantResolution = resume.majorantResolution;
   options.counters = a.counters;
-  // Snapshots between passes: the display server's (its thread sends what changed, ~4 a second)
-  // and --write-partial-images' (the EXR so far, resumable, atomically over the output).
-  std::unique_ptr<DisplayServer> display;
-  if (displayAt)
-    display = std::make_unique<DisplayServer>(*displayAt, out.filename().string(), scene.renderer.width,
-                                              scene.renderer.height);
-  // One timer per consumer: due once `every` has passed since it last took a snapshot.
-  struct Periodic {
-    bool on;
-    std::chrono::duration<double> every;
-    std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
-    bool due() const { return on && std::chrono::steady_clock::now() - last >= every; }
-  };
-  Periodic show{display && display->receiving(), DisplayServer::kUpdateInterval};
-  Periodic save{a.partialEverySeconds > 0, std::chrono::duration<double>(a.partialEverySeconds)};
-  options.snapshotDue = [&]() { return show.due() || save.due(); };
-  options.snapshot = [&](const RenderResult& partial) {
-    if (show.due()) {
-      display->post(partial.image);
-      show.last = std::chrono::steady_clock::now();
-    }
-    if (save.due()) {
-      writeRenderExr(out.string(), partial, renderIdentity(scene));
-      save.last = std::chrono::steady_clock::now();
-    }
-  };
+  snapshots.install(options);
   const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)
                                   : renderPathtrace(rt, scene, g, options);
   bar.finish();
-  if (display) {
-    if (r.image.width > 0) display->finish(r.image);
-    for (const std::string& w : display->warnings()) std::cerr << "narval: warning: " << w << "\n";
-  }
+  snapshots.finish(r);
   for (const std::string& w : r.warnings) std::cerr << "narval: warning: " << w << "\n";
-  const RenderStats& s = r.stats;
   if (r.image.width == 0) {
     std::cerr << "narval: interrupted before the first " << (realtime ? "frame" : "pass") << "; nothing written\n";
     return kExitInterrupted;
   }
-
-  // The EXR, the PNG and the stats land together or not at all (staged_files.h).
-  StagedFiles staged;
-  writeRenderExr(staged.stage(out.string()), r, renderIdentity(scene));
-  writePng(staged.stage(png.string()), r.image, scene.renderer.exposure, scene.renderer.toneMapping);
-  if (!a.statsJson.empty()) {
-    nlohmann::json j = statsJson(s, scene);
-    if (a.frames > 0) j["ms_per_frame"] = framesJson(s.frames);
-    if (s.counters) {
-      j["collisions_tentative"] = s.collisionsTentative;
-      j["collisions_real"] = s.collisionsReal;
-      j["density_lookups"] = s.densityLookups;
-    }
-    writeTextAtomic(staged.stage(a.statsJson), j.dump(2) + "\n");
-  }
-  staged.commit();
-
-  for (const std::string& w : statusWarnings(s.status)) std::cerr << "narval: warning: " << w << "\n";
-  if (s.interrupted) {
-    std::cerr << "narval: interrupted: wrote " << out.string() << " and " << png.string() << " with "
-              << (realtime ? std::to_string(s.passes) + " of " + std::to_string(std::max(1, a.frames)) + " frames"
-                           : std::to_string(s.spp) + " of " + std::to_string(s.sppRequested) +
-                                 " spp; --resume continues it")
-              << "\n";
-    return kExitInterrupted;
-  }
-  if (a.frames > 0)
-    report << s.algorithm << ": " << s.frames.count << " frames, first " << s.frames.firstKernelMs
-              << " ms, then median " << s.frames.medianKernelMs << " ms (min " << s.frames.minKernelMs << ", max "
-              << s.frames.maxKernelMs << ") per frame by profiling events, median " << s.frames.medianWallMs
-              << " ms by wall clock\n";
-  if (s.lightCacheBuilds > 0)
-    report << "light cache: " << s.lightCacheCells[0] << "x" << s.lightCacheCells[1] << "x" << s.lightCacheCells[2]
-              << " cells, " << s.lightCacheBuilds << (s.lightCacheBuilds == 1 ? " light" : " lights") << " built in "
-              << s.lightCacheMs << " ms (not in the frame times)\n";
-  if (s.msCacheBuilds > 0) {
-    report << "multiple-scattering cache: " << s.msCacheCells[0] << "x" << s.msCacheCells[1] << "x"
-           << s.msCacheCells[2] << (s.msCacheView ? " columns x rows x slices, " : " cells, ")
-           << (s.msCacheBudgetMax > 0 ? "a mean of " : "") << s.msCachePaths
-           << " paths per node";
-    if (s.msCacheFilter > 0)
-      report << ", filtered (sigma " << s.msCacheFilter << " columns, tolerance " << s.msCacheFilterTolerance
-             << " standard errors" << (s.msCacheFilterTwicing ? ", twiced" : "") << ")";
-    if (s.msCacheGuide > 0) report << ", guided towards the lights (share " << s.msCacheGuide << ")";
-    if (s.msCacheBudgetMax > 0)
-      report << ", allocated perceptually (" << s.msCacheBudgetMin << "-" << s.msCacheBudgetMax << " paths a column)";
-    report << " in " << s.msCacheMs << " ms (not in the frame times)\n";
-  }
-  report << "wrote " << out.string() << " and " << png.string() << " (" << s.width << "x" << s.height << ", "
-            << s.algorithm << ", ";
-  if (realtime)
-    report << s.frames.count << " frame(s), " << s.frames.medianKernelMs << " ms per frame";
-  else
-    report << (a.samples.empty() ? std::to_string(s.spp) + " spp"
-                                 : "samples [" + std::to_string(s.sampleBegin) + ", " +
-                                       std::to_string(s.sampleBegin + s.spp) + ")")
-           << ", " << s.bounces << " bounces, " << s.seconds << " s, " << s.samplesPerSecond / 1e6
-              << " Msamples/s";
-  report << " on " << s.device << ")\n";
-  return 0;
+  writeOutputs(out, r, scene, a.frames);
+  return reportOutcome(a, out, r.stats, realtime, report);
 }
 
 }  // namespace

@@ -12,18 +12,18 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/image_compare.h"
+#include "analysis/sweep.h"
 #include "app/cli_common.h"
 #include "app/commands.h"
 #include "app/farm_cli.h"
-#include "farm/farm_job.h"
-#include "render/render_exr.h"
 #include "app/progress_bar.h"
+#include "core/input_error.h"
+#include "farm/farm_job.h"
 #include "image/image.h"
-#include "image/image_compare.h"
 #include "render/pathtrace_renderer.h"
 #include "render/render_common.h"
-#include "render/sweep.h"
-#include "scene/input_error.h"
+#include "render/render_exr.h"
 #include "shared/structs.h"
 
 namespace fs = std::filesystem;
@@ -144,29 +144,24 @@ int parseSingle(const std::string& text, const std::string& option, int minimum)
 
 bool isList(const std::string& s) { return s.find(',') != std::string::npos; }
 
-int runSweepCommand(const SweepArgs& a) {
-  // ---- everything is checked before DIR is created or anything rendered
-  if (!a.algorithm.empty() && a.algorithm != "pathtrace")
-    throw inputError("--algorithm", "", "sweep renders with pathtrace only for now, got '" + a.algorithm + "'");
+// Which of --spp and --bounces is swept: the one given as a list (or alone).
+SweepParameter sweptParameter(const SweepArgs& a) {
   const bool hasSpp = !a.spp.empty(), hasBounces = !a.bounces.empty();
   if (!hasSpp && !hasBounces)
     throw inputError("--spp, --bounces", "", "give the values to sweep, e.g. --spp 10,100,1000 or --bounces 50,10,5");
-  SweepParameter parameter;
   if (hasSpp && hasBounces) {
     if (isList(a.spp) == isList(a.bounces))
       throw inputError("--spp, --bounces", "",
                        "sweep exactly one: give one of them as a comma-separated list and the other as a single "
                        "value (got '" + a.spp + "' and '" + a.bounces + "')");
-    parameter = isList(a.spp) ? SweepParameter::Spp : SweepParameter::Bounces;
-  } else {
-    parameter = hasSpp ? SweepParameter::Spp : SweepParameter::Bounces;
+    return isList(a.spp) ? SweepParameter::Spp : SweepParameter::Bounces;
   }
-  const bool sweepSpp = parameter == SweepParameter::Spp;
-  const std::string listOption = sweepSpp ? "--spp" : "--bounces";
-  const std::vector<int> values = parseSweepList(sweepSpp ? a.spp : a.bounces, listOption);
-  if (values.size() < 2 && a.reference.empty())
-    throw inputError(listOption, "", "a sweep needs at least two values (or --reference FILE.exr)");
+  return hasSpp ? SweepParameter::Spp : SweepParameter::Bounces;
+}
 
+// The scene with the fixed parameter and the other flags as overrides, rendered by the path tracer.
+Scene sweepScene(const SweepArgs& a, bool sweepSpp) {
+  const bool hasSpp = !a.spp.empty(), hasBounces = !a.bounces.empty();
   std::vector<std::string> overrides = a.sets;
   if (sweepSpp && hasBounces) overrides.push_back("renderer.bounces=" + std::to_string(parseSingle(a.bounces, "--bounces", 0)));
   if (!sweepSpp && hasSpp) overrides.push_back("renderer.spp=" + std::to_string(parseSingle(a.spp, "--spp", 1)));
@@ -178,6 +173,39 @@ int runSweepCommand(const SweepArgs& a) {
     std::cerr << "narval: warning: " << a.scene << ": renderer.algorithm is \"" << algorithmName(scene.renderer.algorithm)
               << "\"; the sweep renders with pathtrace\n";
   scene.renderer.algorithm = Algorithm::Pathtrace;
+  return scene;
+}
+
+// A finished row: its EXR (unless collected from a farm), its warnings and its line of the table.
+void reportSweepRow(const SweepArgs& a, const Scene& scene, const fs::path& dir, SweepParameter parameter,
+                    const SweepRow& row) {
+  const RenderStats& st = row.stats;
+  const fs::path exr = dir / sweepFileName(parameter, row.value);
+  // The row's spp and bounces from its stats; collected renders are there already.
+  if (!a.collect) writeExr(exr.string(), row.image, renderAttributes(st, renderIdentity(scene)));
+  for (const std::string& w : statusWarnings(st.status))
+    std::cerr << "narval: warning: " << exr.string() << ": " << w << "\n";
+  std::printf("%-14s %10.3f s", sweepLabel(parameter, row.value).c_str(), row.seconds);
+  if (row.isReference)
+    std::printf("  reference\n");
+  else
+    std::printf("  speed-up %7.2f  mean dE76 %6.3f  JND %6.2f%%  mean dE2000 %6.3f  JND2000 %6.2f%%\n", row.speedup,
+                row.dE76.mean, row.dE76.jndPercent, row.dE2000.mean, row.dE2000.jndPercent);
+  std::fflush(stdout);
+}
+
+int runSweepCommand(const SweepArgs& a) {
+  // ---- everything is checked before DIR is created or anything rendered
+  if (!a.algorithm.empty() && a.algorithm != "pathtrace")
+    throw inputError("--algorithm", "", "sweep renders with pathtrace only for now, got '" + a.algorithm + "'");
+  const SweepParameter parameter = sweptParameter(a);
+  const bool sweepSpp = parameter == SweepParameter::Spp;
+  const std::string listOption = sweepSpp ? "--spp" : "--bounces";
+  const std::vector<int> values = parseSweepList(sweepSpp ? a.spp : a.bounces, listOption);
+  if (values.size() < 2 && a.reference.empty())
+    throw inputError(listOption, "", "a sweep needs at least two values (or --reference FILE.exr)");
+
+  Scene scene = sweepScene(a, sweepSpp);
 
   const fs::path dir(a.out);
   if (fs::exists(dir) && !fs::is_directory(dir))
@@ -224,21 +252,7 @@ int runSweepCommand(const SweepArgs& a) {
     warned = true;
     return r;
   };
-  auto onRow = [&](const SweepRow& row) {
-    const RenderStats& st = row.stats;
-    const fs::path exr = dir / sweepFileName(parameter, row.value);
-    // The row's spp and bounces from its stats; collected renders are there already.
-    if (!a.collect) writeExr(exr.string(), row.image, renderAttributes(st, renderIdentity(scene)));
-    for (const std::string& w : statusWarnings(st.status))
-      std::cerr << "narval: warning: " << exr.string() << ": " << w << "\n";
-    std::printf("%-14s %10.3f s", sweepLabel(parameter, row.value).c_str(), row.seconds);
-    if (row.isReference)
-      std::printf("  reference\n");
-    else
-      std::printf("  speed-up %7.2f  mean dE76 %6.3f  JND %6.2f%%  mean dE2000 %6.3f  JND2000 %6.2f%%\n", row.speedup,
-                  row.dE76.mean, row.dE76.jndPercent, row.dE2000.mean, row.dE2000.jndPercent);
-    std::fflush(stdout);
-  };
+  auto onRow = [&](const SweepRow& row) { reportSweepRow(a, scene, dir, parameter, row); };
   SweepSpec spec;
   spec.warmUp = !a.collect;
   spec.parameter = parameter;

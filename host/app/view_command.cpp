@@ -8,8 +8,8 @@
 
 #include "app/cli_common.h"
 #include "app/commands.h"
+#include "core/input_error.h"
 #include "image/image.h"
-#include "scene/input_error.h"
 #include "viewer/viewer_input.h"
 #include "viewer/viewer_session.h"
 #include "viewer/viewer_window.h"
@@ -26,6 +26,35 @@ struct ViewArgs {
   double targetMs = 50;
   int frames = 0;
 };
+
+// The session's --stats-json: frames and their median times per resolution, and the live error.
+nlohmann::json viewStatsJson(const ViewerSession& session, const ViewerWindow& window, const ClRuntime& rt) {
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  nlohmann::json perResolution = nlohmann::json::object();
+  for (const auto& [size, times] : session.frameTimes())
+    perResolution[size] = {{"frames", times.kernelMs.size()},
+                           {"kernel_ms_median", median(times.kernelMs)},
+                           {"frame_ms_median", median(times.frameMs)}};
+  nlohmann::json j = {{"frames", session.frames()},
+                      {"frames_per_resolution", session.framesPerResolution()},
+                      {"per_resolution", perResolution},
+                      {"present_ms_median", median(window.presentMs())},
+                      {"algorithm", algorithmName(session.algorithm())},
+                      {"last_frame_ms", session.lastFrameMs()},
+                      {"device", rt.selected.info.name},
+                      // Frames go through the host; whether the device could share them with OpenGL:
+                      {"gl_sharing_extension",
+                       rt.selected.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_gl_sharing") !=
+                           std::string::npos}};
+  if (session.liveError().valid)
+    j["reference"] = {{"mean_delta_e76", session.liveError().meanDeltaE76},
+                      {"jnd_percent", session.liveError().jndPercent}};
+  return j;
+}
 
 int runView(const ViewArgs& a) {
   std::vector<std::string> overrides = a.sets;
@@ -85,33 +114,7 @@ int runView(const ViewArgs& a) {
     perResolution += (perResolution.empty() ? "" : ", ") + size + ": " + std::to_string(count);
   std::cout << "narval view: " << session.frames() << " frames (" << perResolution << ") on "
             << rt.selected.info.name << "\n";
-  if (!a.statsJson.empty()) {
-    auto median = [](std::vector<double> v) {
-      if (v.empty()) return 0.0;
-      std::sort(v.begin(), v.end());
-      return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-    };
-    nlohmann::json perResolution = nlohmann::json::object();
-    for (const auto& [size, times] : session.frameTimes())
-      perResolution[size] = {{"frames", times.kernelMs.size()},
-                             {"kernel_ms_median", median(times.kernelMs)},
-                             {"frame_ms_median", median(times.frameMs)}};
-    nlohmann::json j = {{"frames", session.frames()},
-                        {"frames_per_resolution", session.framesPerResolution()},
-                        {"per_resolution", perResolution},
-                        {"present_ms_median", median(window.presentMs())},
-                        {"algorithm", algorithmName(session.algorithm())},
-                        {"last_frame_ms", session.lastFrameMs()},
-                        {"device", rt.selected.info.name},
-                        // Frames go through the host; whether the device could share them with OpenGL:
-                        {"gl_sharing_extension",
-                         rt.selected.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_gl_sharing") !=
-                             std::string::npos}};
-    if (session.liveError().valid)
-      j["reference"] = {{"mean_delta_e76", session.liveError().meanDeltaE76},
-                        {"jnd_percent", session.liveError().jndPercent}};
-    writeTextAtomic(a.statsJson, j.dump(2) + "\n");
-  }
+  if (!a.statsJson.empty()) writeTextAtomic(a.statsJson, viewStatsJson(session, window, rt).dump(2) + "\n");
   return 0;
 }
 

@@ -3,15 +3,14 @@
 
 #include <CL/cl_ext.h>  // CL_PLATFORM_NOT_FOUND_KHR
 
+#include <utility>
+
 namespace narval {
 
 namespace {
 
-const char* errorName(int code) {
-#define NARVAL_CL_ERROR(name) \
-  case name:                  \
-    return #name;
-  switch (code) {
+#define NARVAL_CL_ERROR(name) {name, #name},
+const std::pair<int, const char*> kErrorNames[] = {
     // OpenCL 1.2: every code the specification defines.
     NARVAL_CL_ERROR(CL_SUCCESS)
     NARVAL_CL_ERROR(CL_DEVICE_NOT_FOUND)
@@ -74,20 +73,18 @@ const char* errorName(int code) {
     NARVAL_CL_ERROR(CL_INVALID_DEVICE_PARTITION_COUNT)
     // Beyond 1.2, seen from newer drivers and the ICD loader.
     NARVAL_CL_ERROR(CL_PLATFORM_NOT_FOUND_KHR)
-    case -69:
-      return "CL_INVALID_PIPE_SIZE";
-    case -70:
-      return "CL_INVALID_DEVICE_QUEUE";
-    case -71:
-      return "CL_INVALID_SPEC_ID";
-    case -72:
-      return "CL_MAX_SIZE_RESTRICTION_EXCEEDED";
-    case -1000:
-      return "CL_INVALID_GL_SHAREGROUP_REFERENCE_KHR";
-    default:
-      return nullptr;
-  }
+    {-69, "CL_INVALID_PIPE_SIZE"},
+    {-70, "CL_INVALID_DEVICE_QUEUE"},
+    {-71, "CL_INVALID_SPEC_ID"},
+    {-72, "CL_MAX_SIZE_RESTRICTION_EXCEEDED"},
+    {-1000, "CL_INVALID_GL_SHAREGROUP_REFERENCE_KHR"},
+};
 #undef NARVAL_CL_ERROR
+
+const char* errorName(int code) {
+  for (const auto& [value, name] : kErrorNames)
+    if (value == code) return name;
+  return nullptr;
 }
 
 }  // namespace

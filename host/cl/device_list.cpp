@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cl/cl_runtime.h"
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 namespace narval {
 
@@ -22,21 +22,24 @@ struct Found {
   DeviceInfo info;
 };
 
-std::string platformString(cl_platform_id p, cl_platform_info what) {
+// A string query of clGetPlatformInfo or clGetDeviceInfo (`get(size, value, sizeRet)`): "" when
+// the driver refuses it; cut at its terminating NUL.
+template <typename Get>
+std::string infoString(Get&& get) {
   size_t size = 0;
-  if (clGetPlatformInfo(p, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return "";
+  if (get(0, nullptr, &size) != CL_SUCCESS || size == 0) return "";
   std::string s(size, '\0');
-  if (clGetPlatformInfo(p, what, size, &s[0], nullptr) != CL_SUCCESS) return "";
+  if (get(size, &s[0], nullptr) != CL_SUCCESS) return "";
   s.resize(s.find('\0') == std::string::npos ? s.size() : s.find('\0'));
   return s;
 }
 
+std::string platformString(cl_platform_id p, cl_platform_info what) {
+  return infoString([&](size_t n, void* v, size_t* r) { return clGetPlatformInfo(p, what, n, v, r); });
+}
+
 std::string deviceString(cl_device_id d, cl_device_info what) {
-  size_t size = 0;
-  if (clGetDeviceInfo(d, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return "";
-  std::string s(size, '\0');
-  if (clGetDeviceInfo(d, what, size, &s[0], nullptr) != CL_SUCCESS) return "";
-  s.resize(s.find('\0') == std::string::npos ? s.size() : s.find('\0'));
+  std::string s = infoString([&](size_t n, void* v, size_t* r) { return clGetDeviceInfo(d, what, n, v, r); });
   // Some drivers pad names with spaces.
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
   return s;

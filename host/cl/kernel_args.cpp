@@ -24,12 +24,14 @@ const std::map<std::string, std::vector<std::string>>& lists() {
       // counter_buf exists only in the -DCOUNTERS build, as its last argument.
       {"pathtrace", sceneArgsAnd({"accum", "sample_begin", "sample_count", "status_word",
                                   "counter_buf"})},
-      {"raymarch", sceneArgsAnd({"params", "lobe_directions", "light_cache", "ms_cache", "out", "status_word"})},
-      {"lobe", sceneArgsAnd({"params", "lobe_directions", "light_cache", "ms_cache", "out", "status_word"})},
-      {"light_cache_build", sceneArgsAnd({"params", "light", "cache", "status_word"})},
-      {"ms_cache_build", sceneArgsAnd({"params", "first", "count", "cache", "status_word"})},
-      {"ms_cache_place_view", sceneArgsAnd({"params", "cache", "status_word"})},
-      {"ms_cache_filter_view", {"params", "cache", "values", "residual", "filtered"}},
+      {"raymarch", sceneArgsAnd({"march", "light_cache", "ms_cache", "light_cache_nodes", "ms_cache_nodes", "out",
+                                 "status_word"})},
+      {"lobe", sceneArgsAnd({"march", "lobe", "light_cache", "lobe_directions", "light_cache_nodes", "out",
+                             "status_word"})},
+      {"light_cache_build", sceneArgsAnd({"march", "light_cache", "light", "cache", "status_word"})},
+      {"ms_cache_build", sceneArgsAnd({"ms_cache", "first", "count", "cache", "status_word"})},
+      {"ms_cache_place_view", sceneArgsAnd({"ms_cache", "cache", "status_word"})},
+      {"ms_cache_filter_view", {"ms_cache", "cache", "values", "residual", "filtered"}},
   };
   return all;
 }

@@ -7,10 +7,8 @@
 // source, the full build options, platform name and version, device name and driver version. A
 // truncated or corrupt entry is a miss; a binary the driver refuses falls back to the source and
 // the entry is overwritten. The cache never makes a build fail: every cache I/O error is ignored.
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +18,7 @@
 
 #include "cl/cl_runtime.h"
 #include "cl/kernel_sources.h"
+#include "core/atomic_file.h"
 
 namespace narval {
 
@@ -65,29 +64,19 @@ std::string readEntry(const fs::path& file) {
   return fnv1a64(payload) == sum ? payload : "";
 }
 
-// Written to a unique temporary name, then renamed: readers see the old entry or the whole new one.
+// Written atomically: readers see the old entry or the whole new one. A cache that cannot be
+// written costs a build next time, nothing more: failures are ignored.
 void writeEntry(const fs::path& file, const std::string& payload) {
-  static std::atomic<unsigned> counter{0};
   std::error_code ec;
   fs::create_directories(file.parent_path(), ec);
   if (ec) return;
-  const fs::path tmp = file.string() + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
   std::string header(kMagic, sizeof kMagic);
   putU64(header, payload.size());
   putU64(header, fnv1a64(payload));
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return;
-    out.write(header.data(), static_cast<std::streamsize>(header.size()));
-    out.write(payload.data(), static_cast<std::streamsize>(payload.size()));
-    out.close();
-    if (!out) {
-      fs::remove(tmp, ec);
-      return;
-    }
+  try {
+    writeTextAtomic(file.string(), header + payload);
+  } catch (const std::runtime_error&) {
   }
-  fs::rename(tmp, file, ec);
-  if (ec) fs::remove(tmp, ec);
 }
 
 std::string buildLog(const cl::Program& program, const cl::Device& device) {

@@ -11,8 +11,8 @@
 #include <cstring>
 #include <limits>
 
+#include "core/input_error.h"
 #include "display/tev_ipc.h"
-#include "scene/input_error.h"
 
 namespace narval {
 namespace {

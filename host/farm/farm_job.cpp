@@ -3,9 +3,9 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
+#include "core/shell_quote.h"
 #include "render/render_exr.h"
-#include "util/shell_quote.h"
 
 namespace fs = std::filesystem;
 

@@ -6,10 +6,20 @@
 #include <cmath>
 #include <cstdint>
 
-#include "scene/scene.h"
+#include <string>
+
+#include "core/enum_names.h"
 #include "shared/tonemap.h"
 
 namespace narval {
+
+enum class ToneMapping { None, Reinhard, Aces };
+inline const EnumNames<ToneMapping> kToneMappingNames = {
+    {"none", ToneMapping::None}, {"reinhard", ToneMapping::Reinhard}, {"aces", ToneMapping::Aces}};
+inline const char* toneMappingName(ToneMapping t) { return enumName(kToneMappingNames, t); }
+inline bool toneMappingFromName(const std::string& name, ToneMapping* out) {
+  return enumFromName(kToneMappingNames, name, out);
+}
 
 inline int toneMappingKind(ToneMapping tm) {
   switch (tm) {

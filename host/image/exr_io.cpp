@@ -26,9 +26,10 @@
 #include <type_traits>
 #include <variant>
 
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
+#include "core/input_error.h"
+#include "core/number_format.h"
 #include "image/image.h"
-#include "scene/input_error.h"
 
 namespace narval {
 namespace {
@@ -231,14 +232,6 @@ std::vector<Channel> deinterleave(const std::vector<std::string>& names, const s
 // The attributes writeExr can write, as text (readExrAttributes).
 std::map<std::string, std::string> attributesOf(const Imf::Header& header) {
   std::map<std::string, std::string> result;
-  auto shortest = [](double v, int maxDigits) {  // the fewest digits that read back
-    char buf[40];
-    for (int digits = 1; digits <= maxDigits; ++digits) {
-      std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-      if (maxDigits == 9 ? std::strtof(buf, nullptr) == float(v) : std::strtod(buf, nullptr) == v) break;
-    }
-    return std::string(buf);
-  };
   for (auto it = header.begin(); it != header.end(); ++it) {
     const Imf::Attribute& a = it.attribute();
     if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&a)) {
@@ -246,9 +239,9 @@ std::map<std::string, std::string> attributesOf(const Imf::Header& header) {
     } else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&a)) {
       result[it.name()] = std::to_string(i->value());
     } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&a)) {
-      result[it.name()] = shortest(f->value(), 9);
+      result[it.name()] = formatShortest(f->value());
     } else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&a)) {
-      result[it.name()] = shortest(d->value(), 17);
+      result[it.name()] = formatShortest(d->value());
     } else if (const auto* v = dynamic_cast<const Imf::StringVectorAttribute*>(&a)) {
       std::string text;
       for (size_t k = 0; k < v->value().size(); ++k) text += (k ? "\n" : "") + v->value()[k];

@@ -8,7 +8,7 @@
 #include <variant>
 #include <vector>
 
-#include "scene/scene.h"
+#include "image/display_transform.h"
 
 namespace narval {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 #include "image/display_transform.h"
 #include "image/image.h"
 

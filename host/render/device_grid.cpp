@@ -6,8 +6,8 @@
 #include <sstream>
 #include <vector>
 
-#include "render/device_allocation.h"
-#include "scene/input_error.h"
+#include "cl/device_allocation.h"
+#include "core/input_error.h"
 #include "shared/grid.h"
 
 namespace narval {

@@ -11,16 +11,15 @@
 #include "cl/cl_runtime.h"
 #include "scene/scene.h"
 #include "volume/brick_grid.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 
 // The storage `requested` (renderer.storage) comes to on `device`, from the device alone. Auto:
-// the buffer on CPU devices (hand-written trilinear filtering does 3-4x the lookups per second of
-// PoCL's image sampler, DESIGN.md platform facts; whole renders 1.3-1.7x) and on devices without
-// image support; the image elsewhere (GPUs filter in hardware: 1.1-1.5x faster renders on an
-// H100). Image, Buffer and Bricks are returned as they are. chooseGridStorage refines Auto for a
-// grid.
+// the buffer on CPU devices (hand-written trilinear filtering outpaces PoCL's image sampler,
+// DESIGN.md platform facts) and on devices without image support; the image elsewhere (GPUs filter
+// in hardware); timings in bench/RESULTS.md. Image, Buffer and Bricks are returned as they are.
+// chooseGridStorage refines Auto for a grid.
 GridStorage resolveGridStorage(GridStorage requested, const DeviceInfo& device);
 
 // The storage a render of `grid` (null: no grid) uses on `device`: resolveGridStorage, except that
@@ -47,7 +46,7 @@ inline cl::Image3D uploadGrid(ClRuntime& rt, const DenseGrid& grid) { return upl
 
 // A read-only buffer: GRID_BUFFER_HEADER ints (nx, ny, nz, 0), then the voxels. Throws InputError
 // naming the bytes asked for and the device's CL_DEVICE_MAX_MEM_ALLOC_SIZE when they exceed it; a
-// driver refusal is a DeviceFault (render/device_allocation.h).
+// driver refusal is a DeviceFault (host/cl/device_allocation.h).
 cl::Buffer uploadGridBuffer(ClRuntime& rt, const DenseGrid& grid);
 
 // Bytes of the buffer storage of a grid (header included).
@@ -57,7 +56,7 @@ size_t gridBufferBytes(const DenseGrid& grid);
 // pool (kernels/shared/grid.h). Written in chunks of about 64 MiB, so the host holds no second copy
 // of the pool. Throws InputError naming the bytes asked for, the grid's dense size and the device's
 // CL_DEVICE_MAX_MEM_ALLOC_SIZE when even the occupied bricks exceed it; a driver refusal is a
-// DeviceFault (render/device_allocation.h).
+// DeviceFault (host/cl/device_allocation.h).
 cl::Buffer uploadGridBricks(ClRuntime& rt, const DenseGrid& grid, const BrickLayout& layout);
 
 }  // namespace narval

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "render/device_allocation.h"
+#include "cl/device_allocation.h"
 #include "render/device_grid.h"
 #include "render/kernel_features.h"
 

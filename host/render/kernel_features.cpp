@@ -4,7 +4,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 namespace narval {
 namespace {

@@ -3,10 +3,9 @@
 // the path tracer's -D options (kernels/shared/tracking.h: -DMAJORANT_GLOBAL, -DCOUNTERS).
 //
 // Defaults, by measurement (bench/majorant.sh; numbers in bench/RESULTS.md):
-// - majorant "auto": the grid on CPU devices (PoCL, Disney cloud: 2.6x faster than the global
-//   majorant at 16 cells, 3.6x at 32; the generated cloud 1.4x), the global majorant on GPUs (H100:
-//   a DDA cell step costs about what a hardware-filtered lookup saves: Disney 1.0x, generated cloud
-//   0.6x with the grid at 16 cells, worse with more cells).
+// - majorant "auto": the grid on CPU devices (on PoCL faster than the global majorant on both
+//   clouds), the global majorant on GPUs (on an H100 a DDA cell step costs about what a
+//   hardware-filtered lookup saves: the grid at best no faster, slower with more cells).
 // - the path tracer's automatic resolution: 32 cells along the longest axis on CPUs (best or tied on
 //   both clouds), 16 elsewhere (where finer grids cost more); the real-time kernels keep
 //   buildDeviceScene's kDefaultMajorantResolution (16).

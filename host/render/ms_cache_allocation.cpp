@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "image/cielab.h"
+#include "colour/cielab.h"
 #include "image/display_transform.h"
 #include "shared/ms_cache.h"
 #include "shared/ms_cache_view.h"

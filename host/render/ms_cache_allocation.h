@@ -2,11 +2,10 @@
 // takes, when they are spread by what their noise costs the eye instead of evenly
 // (renderer.raymarch.msCache.allocation "perceptual").
 //
-// Why: on the back-lit Disney cloud every pixel the 8-bit judge fails lies in an opaque column, and
-// 83% of them where the reference's L* is 5–70: the bright rims of the cloud's dark body, where the
-// cache's noise is 2.1–2.5 L* rms (one seed against another, over √2); in the dark interior
-// (L* < 5) it is 0.5 and on the white, saturated silhouettes nothing (bench/RESULTS.md). An even
-// share of paths spends most of them where they change no pixel.
+// Why: on the back-lit Disney cloud every pixel the 8-bit judge fails lies in an opaque column, most
+// on the bright rims of the cloud's dark body, where the cache's noise (one seed against another,
+// over √2) is largest; in the dark interior it is small, on the white, saturated silhouettes nil
+// (bench/RESULTS.md). An even share of paths spends most of them where they change no pixel.
 //
 // What: after a pilot of every node (kPilotShare of the mean), column c's pixel is predicted as
 //   Y_c = Σ_s ΔT_s·a·J̄_s + e^{−τ_end}·L_b,
@@ -17,7 +16,7 @@
 // value), so the expected (δL*)² after n_c paths is (L*'(Y_c)·σ_c)²/n_c; at a fixed total it is
 // least for n_c ∝ L*'(Y_c)·σ_c (a Lagrange multiplier), kept within [kFloorShare, kCapShare] of the
 // mean so that no column is left with the few paths whose skewed mean a denoiser then favours
-// (measured: a floor at the pilot darkened the rims by 0.7–1 L*). Both Y_c and σ_c are taken from
+// (a floor at the pilot darkened the rims: bench/RESULTS.md). Both Y_c and σ_c are taken from
 // the column's eight neighbours, not its own pilot: its budget is then independent of its own paths
 // (but for the common scale, and for a column with no neighbour in the medium), so its mean stays
 // unbiased (a node that drew a dim pilot must not be starved; bench/RESULTS.md, the allocation by
@@ -32,8 +31,8 @@
 namespace narval {
 
 // The pilot every node takes before the budgets are set, and the budgets' bounds, as shares of
-// the mean paths per node. Measured on the back-lit Disney cloud (tile 1, a mean of 152, σ_s 1.5,
-// k 2, twiced, cap 2.5x): the floor at the pilot 4.90%, at 0.63 of the mean 4.68% (bench/RESULTS.md).
+// the mean paths per node. The floor: kMsAllocationFloorShare of the mean read the back-lit Disney
+// cloud better than a floor at the pilot (bench/RESULTS.md).
 constexpr double kMsAllocationPilotShare = 0.25;
 constexpr double kMsAllocationFloorShare = 0.625;
 constexpr double kMsAllocationCapShare = 2.5;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "render/device_allocation.h"
+#include "cl/device_allocation.h"
 #include "render/device_scene.h"
 #include "render/majorant_options.h"
 #include "render/render_common.h"
@@ -39,7 +39,7 @@ PathtraceRenderer::PathtraceRenderer(ClRuntime& rt, const Scene& scene, SceneGri
   stats_ = initialStats("pathtrace", rt, scene);
   recordGridStorage(stats_, dev_);
   stats_.majorant = resolveMajorant(options.majorant, rt.selected.info);
-  stats_.counters = options.counters;
+  stats_.counters.on = options.counters;
   applyMajorantResolution(rt, dev_,
                           options.majorantResolution > 0 ? options.majorantResolution
                                                          : pathtraceMajorantResolution(rt.selected.info),
@@ -142,11 +142,11 @@ void PathtraceRenderer::readBack(RenderResult& into) {
   if (options_.counters) {
     std::vector<cl_ulong> counts(pixels * 3);
     rt_.queue.enqueueReadBuffer(counterBuf_, CL_TRUE, 0, counts.size() * sizeof(cl_ulong), counts.data());
-    into.stats.collisionsTentative = into.stats.collisionsReal = into.stats.densityLookups = 0;
+    into.stats.counters.tentative = into.stats.counters.real = into.stats.counters.densityLookups = 0;
     for (size_t i = 0; i < pixels; ++i) {
-      into.stats.collisionsTentative += counts[3 * i + 0];
-      into.stats.collisionsReal += counts[3 * i + 1];
-      into.stats.densityLookups += counts[3 * i + 2];
+      into.stats.counters.tentative += counts[3 * i + 0];
+      into.stats.counters.real += counts[3 * i + 1];
+      into.stats.counters.densityLookups += counts[3 * i + 2];
     }
   }
 }

@@ -8,7 +8,7 @@
 #include "render/device_scene.h"
 #include "render/render_types.h"
 #include "scene/scene.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 

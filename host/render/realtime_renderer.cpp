@@ -3,93 +3,18 @@
 #include <algorithm>
 #include <chrono>
 
-#include "render/device_allocation.h"
+#include "cl/device_allocation.h"
+#include "core/input_error.h"
+#include "render/device_light_cache.h"
+#include "render/device_ms_cache.h"
 #include "render/device_scene.h"
-#include "render/light_cache.h"
-#include "render/ms_cache.h"
-#include "render/node_grid.h"
 #include "render/lobe_directions.h"
 #include "render/majorant_options.h"
+#include "render/node_grid_layout.h"
 #include "render/render_common.h"
-#include "scene/input_error.h"
 #include "volume/majorant_grid.h"
 
 namespace narval {
-
-realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes) {
-  const RendererSettings& r = scene.renderer;
-  const bool lobe = r.algorithm == Algorithm::Lobe;
-  realtime_params p{};
-  p.steps = lobe ? r.lobe.firstHitSteps : r.raymarch.steps;
-  p.shadow_steps = lobe ? r.lobe.shadowSteps : r.raymarch.shadowSteps;
-  p.min_transmittance = lobe ? r.lobe.minTransmittance : r.raymarch.minTransmittance;
-  p.octaves = r.raymarch.multipleScattering == MultipleScattering::Octaves ? r.raymarch.octaves : 1;
-  p.octave_a = r.raymarch.octaveScattering;
-  p.octave_b = r.raymarch.octaveExtinction;
-  p.octave_c = r.raymarch.octavePhase;
-  p.depth_factor = r.lobe.depthFactor;
-  p.lobe_radius = r.lobe.lobeRadius;
-  p.lobe_points = r.lobe.lobePoints;
-  // The variants' defaults where the scene leaves the key out (0): eq7 the dissertation's.
-  int lobeShadowAreaSamples = 1, lobeViewSteps = 24;
-  switch (r.lobe.variant) {
-    case LobeVariant::Eq7: p.lobe_variant = LOBE_EQ7; break;
-    case LobeVariant::Corrected:
-      p.lobe_variant = LOBE_CORRECTED;
-      lobeShadowAreaSamples = 4;
-      lobeViewSteps = 16;
-      break;
-  }
-  if (r.lobe.shadowAreaSamples > 0) lobeShadowAreaSamples = r.lobe.shadowAreaSamples;
-  if (r.lobe.viewSteps > 0) lobeViewSteps = r.lobe.viewSteps;
-  p.view_steps = lobeViewSteps;
-  p.area_light_samples = lobe ? r.lobe.areaLightSamples : r.raymarch.areaLightSamples;
-  p.shadow_area_samples = lobe ? lobeShadowAreaSamples : r.raymarch.shadowAreaSamples;
-  switch (lobe ? r.lobe.areaLightPhase : r.raymarch.areaLightPhase) {
-    case AreaLightPhase::Points: p.area_light_phase = AREA_LIGHT_POINTS; break;
-    case AreaLightPhase::Exact: p.area_light_phase = AREA_LIGHT_EXACT; break;
-  }
-  p.light_cache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
-  p.shadow_weighting = SHADOW_WEIGHTING_AREA;  // the lobe's, and the ray marcher's by default
-  if (!lobe && r.raymarch.shadowWeighting == ShadowWeighting::Phase) p.shadow_weighting = SHADOW_WEIGHTING_PHASE;
-  const MsCacheSettings& mc = r.raymarch.msCache;
-  const bool msCache = !lobe && r.raymarch.multipleScattering == MultipleScattering::Cache;
-  p.ms_cache_tile = mc.tile;
-  switch (mc.layout) {
-    case MsCacheLayout::Grid:
-      p.ms_cache_layout = MS_CACHE_LAYOUT_GRID;
-      if (msCache) p.ms_cache = nodeGridLayout(ds, mc.resolution);
-      break;
-    case MsCacheLayout::View:  // columns over the image, slices along them (ms_cache_view.h)
-      p.ms_cache_layout = MS_CACHE_LAYOUT_VIEW;
-      if (msCache && ds.params.has_medium) {
-        p.ms_cache.nx = (ds.params.camera.width + mc.tile - 1) / mc.tile;
-        p.ms_cache.ny = (ds.params.camera.height + mc.tile - 1) / mc.tile;
-        p.ms_cache.nz = mc.slices;
-      }
-      break;
-  }
-  switch (mc.closure) {
-    case MsCacheClosure::Linear: p.ms_cache_closure = MS_CACHE_CLOSURE_LINEAR; break;
-    case MsCacheClosure::Hg: p.ms_cache_closure = MS_CACHE_CLOSURE_HG; break;
-    case MsCacheClosure::Camera: p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA; break;
-  }
-  if (mc.layout == MsCacheLayout::View) p.ms_cache_closure = MS_CACHE_CLOSURE_CAMERA;  // its paths aim at the camera
-  p.ms_cache_direct = msCache && mc.direct;
-  // The guide draws about the lights where the paths draw from the phase function (phase_guide.h).
-  p.ms_cache_guide = msCache && p.ms_cache_closure == MS_CACHE_CLOSURE_CAMERA ? mc.guide : 0.0f;
-  if (mc.layout == MsCacheLayout::View) {  // the filter over the view nodes (ms_cache_filter.h)
-    p.ms_cache_filter = mc.filter;
-    p.ms_cache_filter_tolerance = mc.filterTolerance;
-    p.ms_cache_filter_twicing = mc.filter > 0 && mc.filterTwicing;
-  }
-  if (p.ms_cache_direct) p.light_cache = node_grid_params{};  // no light loop: no shadow rays to cache
-  switch (r.raymarch.msCache.interpolation) {
-    case MsCacheInterpolation::Geometric: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_GEOMETRIC; break;
-    case MsCacheInterpolation::Linear: p.ms_cache_interpolation = MS_CACHE_INTERPOLATION_LINEAR; break;
-  }
-  return p;
-}
 
 RealtimeRenderer::RealtimeRenderer(ClRuntime& rt, const Scene& scene, SceneGrids grid,
                                    const RenderOptions& options)
@@ -138,22 +63,29 @@ void RealtimeRenderer::setView(const Scene& view) {
     dev_.scene.params.camera = camera;
     rt_.queue.enqueueWriteBuffer(dev_.sceneBuf, CL_TRUE, 0, sizeof(scene_params), &dev_.scene.params);
   }
-  const realtime_params params = realtimeParams(view, dev_.scene, rt_.selected.info.maxAllocBytes);
-  if (rawBytes(params) != rawBytes(params_) || !paramBuf_()) {
-    paramBuf_ = constantBuffer(rt_, params);
-    kernel_.set("params", paramBuf_);
-    if (params.light_cache.nx == 0) kernel_.set("light_cache", noCache_);
-    if (params.ms_cache.nx == 0) kernel_.set("ms_cache", noCache_);
-  }
-  // The lobe's directions depend on its point count (and g, seed: the scene's); one dummy otherwise.
-  if (params.lobe_points != params_.lobe_points || !dirBuf_()) {
-    std::vector<nv_float4> dirs = view.renderer.algorithm == Algorithm::Lobe
-                                      ? lobeDirections(params.lobe_points, dev_.scene.params, view.renderer.seed)
-                                      : std::vector<nv_float4>(1, nv_float4{0, 0, 1, 0});
-    dirCount_ = dirs.size();
-    dirBuf_ = cl::Buffer(rt_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4),
-                         dirs.data());
-    kernel_.set("lobe_directions", dirBuf_);
+  // Each kernel takes the blocks of its features (realtime_params.h); a cache that is off reads a
+  // placeholder, never touched.
+  const RealtimeParams params = realtimeParams(view, dev_.scene, rt_.selected.info.maxAllocBytes);
+  kernel_.set("march", params.march);
+  kernel_.set("light_cache", params.lightCache);
+  if (params.lightCache.nx == 0) kernel_.set("light_cache_nodes", noCache_);
+  switch (view.renderer.algorithm) {
+    case Algorithm::Raymarch:
+      kernel_.set("ms_cache", params.msCache);
+      if (params.msCache.grid.nx == 0) kernel_.set("ms_cache_nodes", noCache_);
+      break;
+    case Algorithm::Lobe:
+      kernel_.set("lobe", params.lobe);
+      // The lobe's directions depend on its point count (and g, seed: the scene's).
+      if (params.lobe.points != params_.lobe.points || !dirBuf_()) {
+        std::vector<nv_float4> dirs = lobeDirections(params.lobe.points, dev_.scene.params, view.renderer.seed);
+        dirCount_ = dirs.size();
+        dirBuf_ = cl::Buffer(rt_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, dirs.size() * sizeof(nv_float4),
+                             dirs.data());
+        kernel_.set("lobe_directions", dirBuf_);
+      }
+      break;
+    case Algorithm::Pathtrace: break;  // refused by checkedScene
   }
   params_ = params;
   if (resized) {
@@ -168,11 +100,11 @@ void RealtimeRenderer::setView(const Scene& view) {
 }
 
 double RealtimeRenderer::renderFrame(bool progressiveCache, double* wallMs) {
-  if (params_.light_cache.nx > 0) {  // a no-op unless the medium or a light changed
-    lightCache_.update(rt_, dev_, params_, view_.sourcePath);
-    kernel_.set("light_cache", lightCache_.buffer());
+  if (params_.lightCache.nx > 0) {  // a no-op unless the medium or a light changed
+    lightCache_.update(rt_, dev_, params_.march, params_.lightCache, view_.sourcePath);
+    kernel_.set("light_cache_nodes", lightCache_.buffer());
   }
-  if (params_.ms_cache.nx > 0) {  // built to its paths (progressively: one launch a frame), then kept
+  if (params_.msCache.grid.nx > 0) {  // built to its paths (progressively: one launch a frame), then kept
     const MsCacheSettings& mc = view_.renderer.raymarch.msCache;
     const int target = progressiveCache ? std::min(mc.paths, msCache_.paths() + mc.pathsPerLaunch) : mc.paths;
     MsCacheAllocation allocation;
@@ -181,8 +113,8 @@ double RealtimeRenderer::renderFrame(bool progressiveCache, double* wallMs) {
     allocation.meanPaths = mc.paths;
     allocation.toneMapping = view_.renderer.toneMapping;
     allocation.exposure = view_.renderer.exposure;
-    msCache_.refine(rt_, dev_, params_, target, mc.pathsPerLaunch, view_.sourcePath, allocation);
-    kernel_.set("ms_cache", msCache_.buffer());
+    msCache_.refine(rt_, dev_, params_.msCache, target, mc.pathsPerLaunch, view_.sourcePath, allocation);
+    kernel_.set("ms_cache_nodes", msCache_.buffer());
   }
   const int W = view_.renderer.width, H = view_.renderer.height;
   const size_t deviceBytes = deviceSceneBytes(dev_.scene) + size_t(W) * size_t(H) * 4 * sizeof(float) +
@@ -204,29 +136,30 @@ RenderResult RealtimeRenderer::result() {
   std::vector<float> rgba(size_t(W) * size_t(H) * 4);
   rt_.queue.enqueueReadBuffer(outBuf_, CL_TRUE, 0, rgba.size() * sizeof(float), rgba.data());
   rt_.queue.enqueueReadBuffer(statusBuf_, CL_TRUE, 0, sizeof(cl_uint), &st.status);
-  st.status |= lightCache_.status();
-  st.lightCacheMs = lightCache_.buildMs();
-  st.lightCacheBuilds = lightCache_.slabsBuilt();
-  st.lightCacheBytes = lightCache_.bytes();
-  nodeGridCells(params_.light_cache, st.lightCacheCells);
-  st.status |= msCache_.status();
-  st.msCacheMs = msCache_.buildMs();
-  st.msCachePaths = msCache_.paths();
-  st.msCacheBuilds = msCache_.rebuilds();
-  st.msCacheView = params_.ms_cache_layout == MS_CACHE_LAYOUT_VIEW;
-  if (st.msCacheView) {  // its nodes are not cell corners: columns, rows, slices
-    st.msCacheCells[0] = params_.ms_cache.nx;
-    st.msCacheCells[1] = params_.ms_cache.ny;
-    st.msCacheCells[2] = params_.ms_cache.nz;
-    st.msCacheFilter = params_.ms_cache_filter;
-    st.msCacheFilterTolerance = params_.ms_cache_filter > 0 ? params_.ms_cache_filter_tolerance : 0;
-    st.msCacheFilterTwicing = params_.ms_cache_filter_twicing != 0;
+  st.status |= lightCache_.status() | msCache_.status();
+  st.lightCache.ms = lightCache_.buildMs();
+  st.lightCache.builds = lightCache_.slabsBuilt();
+  st.lightCache.bytes = lightCache_.bytes();
+  nodeGridCells(params_.lightCache, st.lightCache.cells);
+  MsCacheStats& ms = st.msCache;
+  const ms_cache_params& mc = params_.msCache;
+  ms.ms = msCache_.buildMs();
+  ms.paths = msCache_.paths();
+  ms.builds = msCache_.rebuilds();
+  ms.view = mc.layout == MS_CACHE_LAYOUT_VIEW;
+  if (ms.view) {  // its nodes are not cell corners: columns, rows, slices
+    ms.cells[0] = mc.grid.nx;
+    ms.cells[1] = mc.grid.ny;
+    ms.cells[2] = mc.grid.nz;
+    ms.filter = mc.filter;
+    ms.filterTolerance = mc.filter > 0 ? mc.filter_tolerance : 0;
+    ms.filterTwicing = mc.filter_twicing != 0;
   } else {
-    nodeGridCells(params_.ms_cache, st.msCacheCells);
+    nodeGridCells(mc.grid, ms.cells);
   }
-  st.msCacheGuide = params_.ms_cache_guide;
-  st.msCacheBudgetMin = msCache_.budgetMin();
-  st.msCacheBudgetMax = msCache_.budgetMax();
+  ms.guide = mc.guide;
+  ms.budgetMin = msCache_.budgetMin();
+  ms.budgetMax = msCache_.budgetMax();
   result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
   return result;
 }

@@ -1,8 +1,9 @@
-// realtime_renderer.h: drives the real-time kernels (kernels/raymarch.cl, kernels/lobe.cl), which
-// share one signature: (scene, lights, grid, realtime_params, lobe directions, light cache, RGBA out,
-// status). A frame is one launch that writes the whole image; `frames` launches are timed one by one.
-// The light-transmittance cache (render/light_cache.h) is brought up to date before every frame,
-// which rebuilds it only when what it was built from changed (counted in RenderStats).
+// realtime_renderer.h: drives the real-time kernels (kernels/raymarch.cl, kernels/lobe.cl): the
+// scene's arguments, each feature's parameter block (realtime_params.h), the caches, RGBA out and
+// the status word, bound by name. A frame is one launch that writes the whole image; `frames`
+// launches are timed one by one. The light-transmittance cache (render/device_light_cache.h) is
+// brought up to date before every frame, which rebuilds it only when what it was built from changed
+// (counted in RenderStats).
 #pragma once
 
 #include <cstdint>
@@ -10,21 +11,17 @@
 #include <vector>
 
 #include "cl/cl_runtime.h"
+#include "render/device_light_cache.h"
+#include "render/device_ms_cache.h"
 #include "render/device_scene.h"
-#include "render/light_cache.h"
-#include "render/ms_cache.h"
+#include "render/realtime_params.h"
 #include "render/render_types.h"
 #include "render/scene_upload.h"
 #include "scene/scene.h"
 #include "shared/structs.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
-
-// The kernel parameters from the scene's renderer.raymarch / renderer.lobe / renderer.lightCache
-// settings; the light cache's layout (lightCacheLayout) needs the scene as uploaded.
-// maxAllocBytes: the device's largest allocation, which an automatic cache resolution must fit.
-realtime_params realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes = SIZE_MAX);
 
 // A real-time renderer held across frames: the program, the scene on the device and the caches are
 // built once; the camera, the resolution and the quality settings may change between frames
@@ -56,12 +53,12 @@ class RealtimeRenderer {
   Scene view_;
   RenderOptions options_;
   DeviceSceneBuffers dev_;
-  realtime_params params_{};
+  RealtimeParams params_;
   DeviceLightCache lightCache_;
   DeviceMsCache msCache_;
   cl::Program program_;
   NamedKernel kernel_;
-  cl::Buffer paramBuf_, dirBuf_, outBuf_, statusBuf_, noCache_;
+  cl::Buffer dirBuf_, outBuf_, statusBuf_, noCache_;
   size_t dirCount_ = 0;
   RenderStats stats_;
   std::vector<std::string> warnings_;

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "render/device_allocation.h"
+#include "cl/device_allocation.h"
 #include "render/device_grid.h"
 
 namespace narval {

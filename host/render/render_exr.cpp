@@ -6,9 +6,9 @@
 #include <stdexcept>
 
 #include "cl/cl_runtime.h"
-#include "scene/input_error.h"
+#include "core/input_error.h"
+#include "core/shell_quote.h"
 #include "shared/accum.h"
-#include "util/shell_quote.h"
 
 namespace narval {
 namespace {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 namespace narval {
 

@@ -1,6 +1,6 @@
 #include "render/scene_grids.h"
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 namespace narval {
 

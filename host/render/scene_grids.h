@@ -3,7 +3,7 @@
 #pragma once
 
 #include "scene/scene.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 

@@ -11,10 +11,10 @@
 #include <glm/matrix.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "render/blackbody.h"
+#include "colour/blackbody.h"
+#include "core/input_error.h"
 #include "render/kernel_features.h"
 #include "render/light_selection.h"
-#include "scene/input_error.h"
 #include "shared/light.h"
 #include "shared/phase.h"
 #include "volume/majorant_grid.h"
@@ -223,8 +223,67 @@ bool mediumWorldBounds(const DeviceScene& ds, float lo[3], float hi[3]) {
   return true;
 }
 
-DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids) {
+namespace {
+
+// The medium of volume primitive i (its material, grid and transform) into ds.params.medium, its
+// emission and majorant grid into ds.
+void buildMedium(const Scene& scene, size_t i, SceneGrids grids, DeviceScene& ds) {
   const DenseGrid* grid = grids.density;
+  const Primitive& p = scene.primitives[i];
+  const Material& m = scene.materials.at(size_t(p.materialIndex));
+  scene_params& sp = ds.params;
+  medium_params& med = sp.medium;
+  sp.has_medium = 1;
+  const float D = m.density;
+  med.sigma_a = f4(m.absorption[0] * D, m.absorption[1] * D, m.absorption[2] * D);
+  med.sigma_s = f4(m.scattering[0] * D, m.scattering[1] * D, m.scattering[2] * D);
+  med.phase = phase_make(m.phase, m.phaseParameter);
+  med.grey = m.absorption[0] == m.absorption[1] && m.absorption[1] == m.absorption[2] &&
+             m.scattering[0] == m.scattering[1] && m.scattering[1] == m.scattering[2];
+  float maxSigmaT = 0.0f;
+  for (int c = 0; c < 3; ++c) maxSigmaT = std::max(maxSigmaT, (m.absorption[c] + m.scattering[c]) * D);
+  const float maxDensity = grid ? grid->maxValue : 1.0f;
+  // Trilinear values never exceed the largest voxel; the margin absorbs float rounding so that
+  // 1 - σt/σ̄ never goes negative.
+  med.majorant = maxSigmaT * maxDensity * (1.0f + 1e-5f);
+  const float dims[3] = {grid ? float(grid->nx) : 1.0f, grid ? float(grid->ny) : 1.0f,
+                         grid ? float(grid->nz) : 1.0f};
+  med.dims = f4(dims[0], dims[1], dims[2]);
+  const std::string key = "primitives[" + std::to_string(i) + "].transform";
+  // index -> world: "unit" maps the grid's box onto the primitive's unit cube; "file" keeps
+  // the grid's own index-to-world map and applies the primitive transform on top.
+  nv_affine indexToWorld;
+  if (grid && m.gridSpace == GridSpace::File) {
+    float f[3][4];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) f[r][c] = grid->indexToWorld[size_t(r * 4 + c)];
+    indexToWorld = affineMultiply(transformMatrix(p.transform), fromRows(f));
+  } else {
+    const float u[3][4] = {{1 / dims[0], 0, 0, -0.5f}, {0, 1 / dims[1], 0, -0.5f}, {0, 0, 1 / dims[2], -0.5f}};
+    indexToWorld = affineMultiply(transformMatrix(p.transform), fromRows(u));
+    if (grid && !grid->fileTransformIsScaleTranslate)
+      ds.warnings.push_back(scene.sourcePath + ": " + "materials[" + std::to_string(p.materialIndex) +
+                            "].gridSpace: the grid's file transform rotates or shears; \"unit\" grid space "
+                            "drops it (set \"gridSpace\": \"file\" to keep it)");
+  }
+  try {
+    med.world_to_index = affineInverse(indexToWorld);
+  } catch (const std::domain_error&) {
+    throw inputError(scene.sourcePath, key, "the volume's transform is singular (a zero scale?)");
+  }
+  buildEmission(scene, p.materialIndex, grid, grids.emission, ds);
+  ds.grid = grid;
+  if (grid) {
+    const std::array<int, 3> cells = chooseMajorantResolution(grid->nx, grid->ny, grid->nz);
+    const MajorantGrid mg = buildMajorantGrid(*grid, cells[0], cells[1], cells[2]);
+    med.majorant_grid = mg.params();
+    ds.majorants = mg.maxDensity;
+  }
+}
+
+}  // namespace
+
+DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids) {
   DeviceScene ds;
   scene_params& sp = ds.params;
   sp.camera = buildCamera(scene);
@@ -233,58 +292,10 @@ DeviceScene buildDeviceScene(const Scene& scene, SceneGrids grids) {
   sp.seed = scene.renderer.seed;
   for (size_t i = 0; i < scene.primitives.size(); ++i) {
     const Primitive& p = scene.primitives[i];
-    const Material& m = scene.materials.at(size_t(p.materialIndex));
-    if (p.type != PrimitiveType::Volume) {
-      ds.lights.push_back(buildLight(p, m, sceneRadius(scene)));
-      continue;
-    }
-    medium_params& med = sp.medium;
-    sp.has_medium = 1;
-    const float D = m.density;
-    med.sigma_a = f4(m.absorption[0] * D, m.absorption[1] * D, m.absorption[2] * D);
-    med.sigma_s = f4(m.scattering[0] * D, m.scattering[1] * D, m.scattering[2] * D);
-    med.phase = phase_make(m.phase, m.phaseParameter);
-    med.grey = m.absorption[0] == m.absorption[1] && m.absorption[1] == m.absorption[2] &&
-               m.scattering[0] == m.scattering[1] && m.scattering[1] == m.scattering[2];
-    float maxSigmaT = 0.0f;
-    for (int c = 0; c < 3; ++c) maxSigmaT = std::max(maxSigmaT, (m.absorption[c] + m.scattering[c]) * D);
-    const float maxDensity = grid ? grid->maxValue : 1.0f;
-    // Trilinear values never exceed the largest voxel; the margin absorbs float rounding so that
-    // 1 - σt/σ̄ never goes negative.
-    med.majorant = maxSigmaT * maxDensity * (1.0f + 1e-5f);
-    const float dims[3] = {grid ? float(grid->nx) : 1.0f, grid ? float(grid->ny) : 1.0f,
-                           grid ? float(grid->nz) : 1.0f};
-    med.dims = f4(dims[0], dims[1], dims[2]);
-    const std::string key = "primitives[" + std::to_string(i) + "].transform";
-    // index -> world: "unit" maps the grid's box onto the primitive's unit cube; "file" keeps
-    // the grid's own index-to-world map and applies the primitive transform on top.
-    nv_affine indexToWorld;
-    if (grid && m.gridSpace == GridSpace::File) {
-      float f[3][4];
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) f[r][c] = grid->indexToWorld[size_t(r * 4 + c)];
-      indexToWorld = affineMultiply(transformMatrix(p.transform), fromRows(f));
-    } else {
-      const float u[3][4] = {{1 / dims[0], 0, 0, -0.5f}, {0, 1 / dims[1], 0, -0.5f}, {0, 0, 1 / dims[2], -0.5f}};
-      indexToWorld = affineMultiply(transformMatrix(p.transform), fromRows(u));
-      if (grid && !grid->fileTransformIsScaleTranslate)
-        ds.warnings.push_back(scene.sourcePath + ": " + "materials[" + std::to_string(p.materialIndex) +
-                              "].gridSpace: the grid's file transform rotates or shears; \"unit\" grid space "
-                              "drops it (set \"gridSpace\": \"file\" to keep it)");
-    }
-    try {
-      med.world_to_index = affineInverse(indexToWorld);
-    } catch (const std::domain_error&) {
-      throw inputError(scene.sourcePath, key, "the volume's transform is singular (a zero scale?)");
-    }
-    buildEmission(scene, p.materialIndex, grid, grids.emission, ds);
-    ds.grid = grid;
-    if (grid) {
-      const std::array<int, 3> cells = chooseMajorantResolution(grid->nx, grid->ny, grid->nz);
-      const MajorantGrid mg = buildMajorantGrid(*grid, cells[0], cells[1], cells[2]);
-      med.majorant_grid = mg.params();
-      ds.majorants = mg.maxDensity;
-    }
+    if (p.type == PrimitiveType::Volume)
+      buildMedium(scene, i, grids, ds);
+    else
+      ds.lights.push_back(buildLight(p, scene.materials.at(size_t(p.materialIndex)), sceneRadius(scene)));
   }
   if (ds.majorants.empty()) {
     // One cell over the whole box: density 1 (homogeneous) or 0 (no medium).

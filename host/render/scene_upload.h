@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "shared/structs.h"
 #include "render/scene_grids.h"
 #include "scene/scene.h"
-#include "volume/grid.h"
+#include "shared/structs.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 

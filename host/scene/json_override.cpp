@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 #include "scene/json_reader.h"
 
 namespace narval::scene_detail {

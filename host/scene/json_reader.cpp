@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <limits>
 
+#include "core/number_format.h"
+
 namespace narval::scene_detail {
 
 void JsonContext::fail(const std::string& key, const std::string& what) const {
@@ -65,12 +67,7 @@ bool nearMiss(const std::string& a, const std::string& b) {
 std::string formatNumber(float v) {
   // Whole numbers as written (180, not 1.8e+02); others in the fewest digits that read back.
   if (v == std::floor(v) && std::fabs(v) < 1e9f) return std::to_string(static_cast<long long>(v));
-  char buf[32];
-  for (int precision = 1; precision <= 9; ++precision) {
-    std::snprintf(buf, sizeof buf, "%.*g", precision, static_cast<double>(v));
-    if (static_cast<float>(std::strtod(buf, nullptr)) == v) break;
-  }
-  return buf;
+  return formatShortest(v);
 }
 
 namespace {
@@ -207,6 +204,36 @@ void ObjectReader::reportUnknown() {
     else
       ctx_.nearMisses.emplace_back(key, keyOf(meant));
   }
+}
+
+void checkNonNegative(const JsonContext& ctx, const std::string& key, float v) {
+  if (!(v >= 0)) ctx.fail(key, "must be non-negative, got " + formatNumber(v));
+}
+
+void checkNonNegative(const JsonContext& ctx, const std::string& key, const Vec3f& v) {
+  for (size_t i = 0; i < 3; ++i) checkNonNegative(ctx, indexKey(key, i), v[i]);
+}
+
+int64_t checkIntRange(const JsonContext& ctx, const std::string& key, int64_t v, int64_t lo, int64_t hi) {
+  if (v < lo) ctx.fail(key, "must be at least " + std::to_string(lo) + ", got " + std::to_string(v));
+  if (v > hi) ctx.fail(key, "must be at most " + std::to_string(hi) + ", got " + std::to_string(v));
+  return v;
+}
+
+int readInt(ObjectReader& r, const std::string& name, int fallback, int64_t lo, int64_t hi) {
+  return static_cast<int>(checkIntRange(r.context(), r.keyOf(name), r.getInteger(name, fallback), lo, hi));
+}
+
+float readNonNegative(ObjectReader& r, const std::string& name, float fallback) {
+  const float v = r.getFloat(name, fallback);
+  checkNonNegative(r.context(), r.keyOf(name), v);
+  return v;
+}
+
+float readUnitInterval(ObjectReader& r, const std::string& name, float fallback) {
+  const float v = r.getFloat(name, fallback);
+  if (!(v >= 0 && v <= 1)) r.context().fail(r.keyOf(name), "must be in [0, 1], got " + formatNumber(v));
+  return v;
 }
 
 }  // namespace narval::scene_detail

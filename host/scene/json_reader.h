@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <set>
 #include <string>
 #include <utility>
@@ -11,7 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scene/input_error.h"
+#include "core/enum_names.h"
+#include "core/input_error.h"
 #include "scene/scene.h"
 
 namespace narval::scene_detail {
@@ -91,5 +93,34 @@ class ObjectReader {
   std::string key_;
   std::vector<std::string> known_;
 };
+
+// An enumeration's value by its name (core/enum_names.h): "KEY: unknown value "x" (allowed: ...)".
+template <typename E>
+E toEnum(const JsonContext& ctx, const json& v, const std::string& key, const EnumNames<E>& names) {
+  const std::string s = toString(ctx, v, key);
+  E value;
+  if (!enumFromName(names, s, &value)) ctx.fail(key, "unknown value \"" + s + "\" (allowed: " + enumNameList(names) + ")");
+  return value;
+}
+
+template <typename E>
+E readEnum(ObjectReader& r, const std::string& name, const EnumNames<E>& names, E fallback) {
+  const json* v = r.find(name);
+  return v ? toEnum(r.context(), *v, r.keyOf(name), names) : fallback;
+}
+
+template <typename E>
+E requireEnum(ObjectReader& r, const std::string& name, const EnumNames<E>& names) {
+  return toEnum(r.context(), r.require(name), r.keyOf(name), names);
+}
+
+// Range checks: the message names the value as the user wrote it.
+constexpr int64_t kIntMax = std::numeric_limits<int>::max();
+void checkNonNegative(const JsonContext& ctx, const std::string& key, float v);
+void checkNonNegative(const JsonContext& ctx, const std::string& key, const Vec3f& v);
+int64_t checkIntRange(const JsonContext& ctx, const std::string& key, int64_t v, int64_t lo, int64_t hi);
+int readInt(ObjectReader& r, const std::string& name, int fallback, int64_t lo, int64_t hi = kIntMax);
+float readNonNegative(ObjectReader& r, const std::string& name, float fallback);
+float readUnitInterval(ObjectReader& r, const std::string& name, float fallback);
 
 }  // namespace narval::scene_detail

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "image/display_transform.h"
 #include "shared/light_kinds.h"
 #include "shared/phase_kinds.h"
 
@@ -30,7 +31,7 @@ enum class GridSpace { Unit, File };
 // per unit length, Le = color · scale · v(x) (Color: v from the grid `grid` of the volume's file,
 // or 1 without one) or scale · B((v(x) − temperatureOffset) · temperatureScale) (Blackbody: v from
 // the temperature grid `grid`, or the constant `temperature` in kelvin; B the blackbody colour of
-// render/blackbody.h, nothing at or below 100 K).
+// host/colour/blackbody.h, nothing at or below 100 K).
 enum class EmissionKind { None, Color, Blackbody };
 struct Emission {
   EmissionKind kind = EmissionKind::None;
@@ -80,15 +81,13 @@ struct Camera {
   float speed = 1.0f;        // viewer navigation only
 };
 
-enum class ToneMapping { None, Reinhard, Aces };
-
 // How the density grid lives on the device (kernels/shared/grid.h): a 3D image read with the
 // hardware sampler, a float buffer filtered by hand (kernels/shared/grid.h's grid_trilinear), or
 // sparse 8³ bricks with an index table (the same filter, bit for bit; only bricks holding density
-// take memory: grids beyond one image or buffer). Auto: the buffer on CPU devices (on PoCL 3-4x
-// the image's lookups per second, 1.3-1.7x faster renders) and on devices without image support,
-// the image elsewhere (GPUs filter in hardware: 1.1-1.5x faster renders on an H100); bricks, with a
-// warning, when that choice cannot hold the grid. render/device_grid.h resolves it.
+// take memory: grids beyond one image or buffer). Auto: the buffer on CPU devices (faster than
+// PoCL's image sampler) and on devices without image support, the image elsewhere (GPUs filter in
+// hardware); timings in bench/RESULTS.md. Bricks, with a warning, when that choice cannot hold the
+// grid. render/device_grid.h resolves it.
 enum class GridStorage { Auto, Image, Buffer, Bricks };
 
 // What the ray marcher adds for light scattered more than once: nothing, Wrenninge's octaves, or
@@ -174,8 +173,8 @@ enum class LightSampling { All, Power, Fluence };
 struct PathtraceSettings {
   LightSampling lightSampling = LightSampling::All;
   // Ratio-tracked shadow rays play Russian roulette once their transmittance is below this in
-  // every channel (kernels/shared/tracking.h); 0 = never. pbrt-v4's threshold; measured on PoCL
-  // (bench/pathtrace_sampling.py): 2.2x the efficiency on the default cloud, 3.0x on the Disney cloud.
+  // every channel (kernels/shared/tracking.h); 0 = never. pbrt-v4's threshold; it raises the
+  // efficiency on both clouds (bench/pathtrace_sampling.py, bench/RESULTS.md).
   float shadowRoulette = 0.05f;
 };
 
@@ -251,9 +250,6 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
 Scene parseScene(const std::string& jsonText, const std::string& path,
                  const std::vector<std::string>& overrides = {}, std::set<std::string>* keysAsked = nullptr);
 
-const char* toneMappingName(ToneMapping t);
-// The inverse of toneMappingName ("none", "reinhard", "aces"); false for any other name.
-bool toneMappingFromName(const std::string& name, ToneMapping* out);
 // "auto", "image", "buffer" or "bricks": the scene file's spelling.
 const char* gridStorageName(GridStorage s);
 

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 namespace narval::scene_detail {
 

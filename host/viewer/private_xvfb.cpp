@@ -11,7 +11,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 namespace narval {
 

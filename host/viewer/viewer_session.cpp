@@ -9,7 +9,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
+#include "core/number_format.h"
 #include "image/bitmap_font.h"
 #include "render/render_common.h"
 #include "render/render_exr.h"
@@ -32,11 +33,6 @@ const char* const kHelp[] = {
 
 std::string sizeName(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
-std::string fixed(double v, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", digits, v);
-  return text;
-}
 
 // Whether the camera is where the scene put it, to 1e-4 of the look-at distance (the reference's
 // pose: orbiting away and back leaves rounding in the last bits).
@@ -268,10 +264,10 @@ void ViewerSession::compose(const ImageRGB& image) {
   if (!help_) return;
   // The help overlay: a dimmed box with the keys, then the status line, at the top left.
   std::vector<std::string> lines(std::begin(kHelp), std::end(kHelp));
-  lines.push_back(algorithmName(algorithm_) + std::string("  ") + fixed(lastMs_, 1) + " MS  " + sizeName(lastWidth_, lastHeight_) + "  " +
+  lines.push_back(algorithmName(algorithm_) + std::string("  ") + formatFixed(lastMs_, 1) + " MS  " + sizeName(lastWidth_, lastHeight_) + "  " +
                   std::to_string(spp_) + " SPP");
   if (liveError_.valid)
-    lines.push_back("DE76 " + fixed(liveError_.meanDeltaE76, 2) + "  JND " + fixed(liveError_.jndPercent, 1) + "%");
+    lines.push_back("DE76 " + formatFixed(liveError_.meanDeltaE76, 2) + "  JND " + formatFixed(liveError_.jndPercent, 1) + "%");
   const int scale = fullW >= 960 ? 2 : 1, lineHeight = (kFontHeight + 3) * scale;
   int boxW = 0;
   for (const std::string& l : lines) boxW = std::max(boxW, fontTextWidth(l, scale));
@@ -332,10 +328,10 @@ std::vector<std::string> ViewerSession::takeMessages() {
 
 std::string ViewerSession::title() const {
   std::string t = "narval view: " + fs::path(scene_.sourcePath).filename().string() + " | " + algorithmName(algorithm_) + " | " +
-                  fixed(lastMs_, 1) + " ms | " + sizeName(lastWidth_, lastHeight_) + " | " + std::to_string(spp_) +
+                  formatFixed(lastMs_, 1) + " ms | " + sizeName(lastWidth_, lastHeight_) + " | " + std::to_string(spp_) +
                   " spp | " + rt_.selected.info.name;
   if (liveError_.valid)
-    t += " | ΔE76 " + fixed(liveError_.meanDeltaE76, 2) + ", JND " + fixed(liveError_.jndPercent, 1) + "%";
+    t += " | ΔE76 " + formatFixed(liveError_.meanDeltaE76, 2) + ", JND " + formatFixed(liveError_.jndPercent, 1) + "%";
   return t;
 }
 

@@ -10,15 +10,15 @@
 #include <string>
 #include <vector>
 
+#include "analysis/image_compare.h"
 #include "cl/cl_runtime.h"
 #include "image/image.h"
-#include "image/image_compare.h"
 #include "render/pathtrace_renderer.h"
 #include "render/realtime_renderer.h"
 #include "scene/scene.h"
 #include "viewer/orbit_camera.h"
 #include "viewer/viewer_input.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 

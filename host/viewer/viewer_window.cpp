@@ -7,8 +7,8 @@
 
 #include <GLFW/glfw3.h>
 
+#include "core/input_error.h"
 #include "image/image.h"
-#include "scene/input_error.h"
 
 namespace narval {
 namespace {

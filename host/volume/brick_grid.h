@@ -1,7 +1,7 @@
 // brick_grid.h: a dense grid cut into sparse bricks, the layout kernels/shared/grid.h reads with
 // -DGRID_STORAGE_BRICKS (8³ voxels per brick plus a one-voxel apron, an index table, a pool of the
 // occupied bricks; the layout is documented there). For grids that fit neither one 3D image nor one
-// buffer on the device (issue 6, item 6): only bricks holding a non-zero value take memory.
+// buffer on the device: only bricks holding a non-zero value take memory.
 //
 // Two passes, so the pool can be written straight into device memory (render/device_grid.cpp) in
 // chunks without a second whole copy on the host: planBricks finds the occupied bricks,
@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 

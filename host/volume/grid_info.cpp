@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scene/input_error.h"
-#include "volume/grid.h"
+#include "core/input_error.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 namespace {

@@ -27,7 +27,7 @@ struct GridInfo {
 };
 
 // The grids of a .vdb or .vol file. Throws InputError naming the file on anything unreadable
-// (a corrupt .vdb is read in a child process, as the loaders do: volume/grid.h).
+// (a corrupt .vdb is read in a child process, as the loaders do: host/volume/dense_grid.h).
 std::vector<GridInfo> inspectGridFile(const std::string& path);
 std::vector<GridInfo> inspectVdb(const std::string& path);
 

@@ -18,7 +18,7 @@
 // j > A - 1.5 and j < B + 0.5), and at a voxel centre inside the cell the density equals that voxel
 // (weight 1), so when the largest relevant voxel has its centre in the cell the bound is attained.
 //
-// Float rounding. The DDA (kernels/shared/majorant.h) assigns points to cells with float
+// Float rounding. The DDA (kernels/shared/majorant_dda.h) assigns points to cells with float
 // arithmetic, a few ulps of the index coordinates either side of a face, so every cell is grown by
 // MAJORANT_SLACK = 1/256 index units before taking its range: that only enlarges the range, and
 // the bound holds up to 1/256 outside the cell. It costs nothing except where a cell face lies on

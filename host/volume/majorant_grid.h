@@ -1,13 +1,13 @@
 // majorant_grid.h: a coarse grid of density bounds over a DenseGrid's box (pbrt-v4's MajorantGrid),
-// walked on the device by the DDA in kernels/shared/majorant.h: empty-space skipping for the
+// walked on the device by the DDA in kernels/shared/majorant_dda.h: empty-space skipping for the
 // real-time kernels, a per-cell σ̄ for delta and ratio tracking in the path tracer.
 #pragma once
 
 #include <array>
 #include <vector>
 
-#include "shared/majorant.h"
-#include "volume/grid.h"
+#include "shared/majorant_dda.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 
@@ -23,7 +23,7 @@ struct MajorantGrid {
     return maxDensity[size_t(x) + size_t(cellsX) * (size_t(y) + size_t(cellsY) * size_t(z))];
   }
   size_t cellCount() const { return size_t(cellsX) * size_t(cellsY) * size_t(cellsZ); }
-  // The struct the DDA takes (kernels/shared/majorant.h), ready to cross to the device.
+  // The struct the DDA takes (kernels/shared/majorant_dda.h), ready to cross to the device.
   majorant_grid_params params() const;
 };
 

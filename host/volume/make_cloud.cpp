@@ -23,7 +23,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 namespace {

@@ -1,6 +1,7 @@
-// vdb_io.cpp: OpenVDB <-> DenseGrid. The only translation unit that includes OpenVDB (it costs
-// ~15 s to compile), so everything OpenVDB-related lives here, test-file writers included.
-#include "volume/grid.h"
+// vdb_io.cpp: OpenVDB -> DenseGrid: reading, listing and describing a .vdb file's grids (writing:
+// vdb_write.cpp). OpenVDB's headers are slow to compile: only these two files include them.
+#include "volume/child_reader.h"
+#include "volume/vdb_io.h"
 
 #include <algorithm>
 #include <array>
@@ -36,11 +37,11 @@
 #include <openvdb/tools/Dense.h>
 #include <tbb/task_arena.h>
 
-#include "scene/input_error.h"
+#include "core/atomic_file.h"
+#include "core/input_error.h"
 #include "volume/grid_info.h"
 
 namespace narval {
-namespace {
 
 namespace fs = std::filesystem;
 
@@ -48,6 +49,16 @@ void initOpenVdb() {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
 }
+
+std::string oneLine(const char* what) {
+  std::string s(what);
+  for (char& c : s) {
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  }
+  return s;
+}
+
+namespace {
 
 // A missing or unreadable file gets a plain message before OpenVDB sees it (its own messages name
 // a temporary copy or nothing at all).
@@ -61,15 +72,6 @@ void requireReadableFile(const std::string& path) {
 }
 
 std::string quoted(const std::string& name) { return "'" + name + "'"; }
-
-// An exception's text made fit for a one-line message (OpenVDB's can span lines).
-std::string oneLine(const char* what) {
-  std::string s(what);
-  for (char& c : s) {
-    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
-  }
-  return s;
-}
 
 struct GridEntry {
   std::string name;
@@ -115,69 +117,28 @@ std::string describeGrids(const std::vector<GridEntry>& grids) {
   return s;
 }
 
-std::string dimsString(uint64_t x, uint64_t y, uint64_t z) {
+
+std::string dimsString(int64_t x, int64_t y, int64_t z) {
   return std::to_string(x) + "x" + std::to_string(y) + "x" + std::to_string(z);
 }
 
-// Writes with `write(tmpPath)` then renames over `path`, so a reader never sees half a file.
-template <typename WriteFn>
-void writeAtomically(const std::string& path, WriteFn&& write) {
-  const std::string tmp = path + ".tmp";
-  try {
-    write(tmp);
-  } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw inputError(path, "", "cannot write the file (" + oneLine(e.what()) + ")");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw inputError(path, "", "cannot write the file (rename failed: " + ec.message() + ")");
-  }
+// The grid named `gridName` must exist and hold floats: one line naming what the file has.
+void requireFloatGrid(const std::string& path, const std::string& gridName) {
+  openvdb::io::File file(path);
+  const std::vector<GridEntry> grids = listGrids(file, path);
+  const auto entry = std::find_if(grids.begin(), grids.end(), [&](const GridEntry& g) { return g.name == gridName; });
+  if (entry == grids.end())
+    throw inputError(path, "grid", "no grid named " + quoted(gridName) + " (" + describeGrids(grids) + ")");
+  if (entry->isFloat) return;
+  std::string floats;
+  for (const GridEntry& g : grids)
+    if (g.isFloat) floats += (floats.empty() ? "" : ", ") + g.name;
+  throw inputError(path, "grid",
+                   quoted(gridName) + " is a " + entry->valueType + " grid; narval needs a float grid (" +
+                       (floats.empty() ? std::string("the file has none") : "float grids in the file: " + floats) + ")");
 }
 
-void writeGrids(const std::string& path, const openvdb::GridPtrVec& grids) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    openvdb::io::File out(tmp);
-    out.write(grids);
-    out.close();
-  });
-}
-
-// Where decodeVdb puts its result: the dense values go to `allocate(n)`'s n floats.
-struct Decoded {
-  int nx = 0, ny = 0, nz = 0;
-  std::array<float, 12> indexToWorld{};
-  bool scaleTranslate = true;
-};
-
-// Everything that parses the file: grid lookup, type and transform checks, the active bounding
-// box, the size limit and the dense copy. Throws InputError (the full one-line message).
-template <typename Allocate>
-Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate&& allocate, bool serial) {
-  {
-    openvdb::io::File file(path);
-    const std::vector<GridEntry> grids = listGrids(file, path);
-    const auto entry =
-        std::find_if(grids.begin(), grids.end(), [&](const GridEntry& g) { return g.name == gridName; });
-    if (entry == grids.end()) {
-      throw inputError(path, "grid", "no grid named " + quoted(gridName) + " (" + describeGrids(grids) + ")");
-    }
-    if (!entry->isFloat) {
-      std::string floats;
-      for (const GridEntry& g : grids) {
-        if (g.isFloat) floats += (floats.empty() ? "" : ", ") + g.name;
-      }
-      throw inputError(path, "grid",
-                       quoted(gridName) + " is a " + entry->valueType + " grid; narval needs a float grid (" +
-                           (floats.empty() ? std::string("the file has none") : "float grids in the file: " + floats) +
-                           ")");
-    }
-  }
-
+openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string& gridName) {
   openvdb::FloatGrid::Ptr grid;
   try {
     const openvdb::GridPtrVecPtr all = readAllGrids(path);  // keep it alive through the loop
@@ -195,50 +156,32 @@ Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate
                                        oneLine(e.what()) + ")");
   }
   if (!grid) throw inputError(path, "grid", "cannot read " + quoted(gridName) + " as a float grid");
+  return grid;
+}
 
-  // Transform: affine only (a frustum map is not linear).
-  const openvdb::math::MapBase::ConstPtr map = grid->transform().baseMap();
-  if (!map->isLinear()) {
-    throw inputError(path, "grid", quoted(gridName) + " has a non-affine index-to-world transform (" + map->type() +
-                                       "); narval supports affine transforms only");
-  }
-  const openvdb::Mat4d m = map->getAffineMap()->getMat4();  // row vectors: world = [ijk 1] * m
-
-  const openvdb::CoordBBox bbox = grid->evalActiveVoxelBoundingBox();
-  if (grid->activeVoxelCount() == 0 || bbox.empty()) {
-    throw inputError(path, "grid", quoted(gridName) + " has no active voxels");
-  }
-  // In 64 bits: a corrupt tree can span more than 2^31 voxels per axis (Coord::dim would wrap).
-  const int64_t dim[3] = {int64_t(bbox.max().x()) - bbox.min().x() + 1, int64_t(bbox.max().y()) - bbox.min().y() + 1,
-                          int64_t(bbox.max().z()) - bbox.min().z() + 1};
-  // Dims are ints, an x-y slice's voxel count too (grid_trilinear's stride), and the whole grid at
-  // most kMaxDenseGridBytes (volume/grid.h). Checked in this order, no product overflows.
+// Dims are ints, an x-y slice's voxel count too (grid_trilinear's stride), and the whole grid at
+// most kMaxDenseGridBytes (host/volume/dense_grid.h). Checked in this order, no product overflows;
+// in 64 bits, as a corrupt tree can span more than 2^31 voxels per axis.
+void requireDenseSize(const std::string& path, const std::string& gridName, const int64_t dim[3]) {
   constexpr int64_t kMaxDim = INT32_MAX;
   constexpr uint64_t kMaxVoxels = kMaxDenseGridBytes / sizeof(float);
   const bool tooBig = dim[0] > kMaxDim || dim[1] > kMaxDim || dim[2] > kMaxDim ||
                       uint64_t(dim[0]) * uint64_t(dim[1]) > uint64_t(kMaxDim) ||
                       uint64_t(dim[0]) * uint64_t(dim[1]) * uint64_t(dim[2]) > kMaxVoxels;
-  if (tooBig) {
-    const bool showCount = dim[0] < (1 << 20) && dim[1] < (1 << 20) && dim[2] < (1 << 20);
-    const uint64_t voxels = uint64_t(dim[0]) * uint64_t(dim[1]) * uint64_t(dim[2]);
-    throw inputError(path, "grid",
-                     quoted(gridName) + " active bounding box " + dimsString(dim[0], dim[1], dim[2]) +
-                         (showCount ? " = " + std::to_string(voxels) + " voxels needs " +
-                                          std::to_string((voxels * sizeof(float)) >> 20) + " MiB as dense floats,"
-                                    : " is") +
-                         " over the " + std::to_string(kMaxDenseGridBytes >> 20) + " MiB limit");
-  }
+  if (!tooBig) return;
+  const bool showCount = dim[0] < (1 << 20) && dim[1] < (1 << 20) && dim[2] < (1 << 20);
+  const uint64_t voxels = uint64_t(dim[0]) * uint64_t(dim[1]) * uint64_t(dim[2]);
+  throw inputError(path, "grid",
+                   quoted(gridName) + " active bounding box " + dimsString(dim[0], dim[1], dim[2]) +
+                       (showCount ? " = " + std::to_string(voxels) + " voxels needs " +
+                                        std::to_string((voxels * sizeof(float)) >> 20) + " MiB as dense floats,"
+                                  : " is") +
+                       " over the " + std::to_string(kMaxDenseGridBytes >> 20) + " MiB limit");
+}
 
-  Decoded out;
-  out.nx = int(dim[0]);
-  out.ny = int(dim[1]);
-  out.nz = int(dim[2]);
-  {
-    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, allocate(size_t(dim[0] * dim[1] * dim[2])));
-    openvdb::tools::copyToDense(*grid, dense, serial);
-  }
-
-  // Our index u (voxel i covers [i, i+1]) -> vdb index ijk = u - 0.5 + bbox.min -> world.
+// Our index u (voxel i covers [i, i+1]) -> vdb index ijk = u - 0.5 + bbox.min -> world, from the
+// affine map's row-vector matrix m (world = [ijk 1] * m).
+void setIndexToWorld(Decoded& out, const openvdb::Mat4d& m, const openvdb::CoordBBox& bbox) {
   const openvdb::Vec3d shift(bbox.min().x() - 0.5, bbox.min().y() - 0.5, bbox.min().z() - 0.5);
   double maxDiag = 0.0;
   for (int r = 0; r < 3; ++r) maxDiag = std::max(maxDiag, std::abs(m[r][r]));
@@ -251,6 +194,36 @@ Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate
     }
     out.indexToWorld[size_t(r * 4 + 3)] = float(t);
   }
+}
+
+// Everything that parses the file: grid lookup, type and transform checks, the active bounding
+// box, the size limit and the dense copy. Throws InputError (the full one-line message).
+template <typename Allocate>
+Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate&& allocate, bool serial) {
+  requireFloatGrid(path, gridName);
+  const openvdb::FloatGrid::Ptr grid = readFloatGrid(path, gridName);
+  // Transform: affine only (a frustum map is not linear).
+  const openvdb::math::MapBase::ConstPtr map = grid->transform().baseMap();
+  if (!map->isLinear()) {
+    throw inputError(path, "grid", quoted(gridName) + " has a non-affine index-to-world transform (" + map->type() +
+                                       "); narval supports affine transforms only");
+  }
+  const openvdb::CoordBBox bbox = grid->evalActiveVoxelBoundingBox();
+  if (grid->activeVoxelCount() == 0 || bbox.empty()) {
+    throw inputError(path, "grid", quoted(gridName) + " has no active voxels");
+  }
+  const int64_t dim[3] = {int64_t(bbox.max().x()) - bbox.min().x() + 1, int64_t(bbox.max().y()) - bbox.min().y() + 1,
+                          int64_t(bbox.max().z()) - bbox.min().z() + 1};
+  requireDenseSize(path, gridName, dim);
+  Decoded out;
+  out.nx = int(dim[0]);
+  out.ny = int(dim[1]);
+  out.nz = int(dim[2]);
+  {
+    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, allocate(size_t(dim[0] * dim[1] * dim[2])));
+    openvdb::tools::copyToDense(*grid, dense, serial);
+  }
+  setIndexToWorld(out, map->getAffineMap()->getMat4(), bbox);
   return out;
 }
 
@@ -327,101 +300,6 @@ std::vector<GridInfo> describeVdbGrids(const std::string& path) {
 }
 
 #if defined(__linux__)
-// OpenVDB 10's readers trust the sizes and flags they find in a file. Corrupted bytes inside
-// compressed leaf data (a size field larger than its buffer, a wrong mask flag) overflow a heap
-// buffer in io::readCompressedValues / io::bloscFromStream: that aborts the process ("double free
-// or corruption") or, worse, corrupts the heap silently and crashes it later. A corrupted length
-// in the metadata makes it build (and zero) a string of up to 4 GiB. None of this can be caught,
-// so every read of a file's contents runs in a forked child that shares nothing with us but a
-// memfd: it writes a result record (and the dense values after the first page) there. A child
-// that dies on a signal, or runs past a time limit, is reported as a corrupt file. The child runs
-// single-threaded (a one-slot TBB arena and a serial copy: the parent's TBB workers do not exist
-// in it), writes nothing to our stderr and leaves with _exit. NARVAL_VDB_IN_PROCESS=1 reads in
-// this process instead (for debuggers and memory checkers).
-struct ChildRecord {
-  uint64_t magic;
-  int32_t ok;  // 1: result (Decoded, or names in the data area); 0: InputError message; -1: other error
-  uint32_t payloadBytes;  // names: bytes after the first page
-  Decoded decoded;
-  char message[3072];
-};
-constexpr uint64_t kRecordMagic = 0x6e617276616c7664ull;  // "narvalvd"
-constexpr size_t kDataOffset = 4096;
-static_assert(sizeof(ChildRecord) <= kDataOffset, "the record fits in the first page");
-
-struct Fd {
-  int fd = -1;
-  Fd() = default;
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  ~Fd() {
-    if (fd >= 0) ::close(fd);
-  }
-};
-
-// Runs `work(fd, record)` in a child; returns false (nothing ran) when no child can be used.
-// After a true return `mem` holds what the child wrote and `rec` its record (ok == 1); InputErrors
-// from the child, crashes and time-outs are thrown here as "PATH: grid: CANNOT (...)".
-template <typename Work>
-bool runInChild(const std::string& path, const std::string& cannot, Work&& work, Fd& mem, ChildRecord& rec) {
-  if (std::getenv("NARVAL_VDB_IN_PROCESS")) return false;
-  mem.fd = ::memfd_create("narval-vdb", MFD_CLOEXEC);
-  if (mem.fd < 0) return false;
-  const pid_t pid = ::fork();
-  if (pid < 0) return false;
-  if (pid == 0) {
-    struct rlimit noCore{0, 0};
-    ::setrlimit(RLIMIT_CORE, &noCore);
-    const int devNull = ::open("/dev/null", O_WRONLY);
-    if (devNull >= 0) ::dup2(devNull, 2);  // allocator diagnostics are ours to report
-    ChildRecord out{};
-    out.magic = kRecordMagic;
-    try {
-      tbb::task_arena arena(1, 1);
-      arena.execute([&] { work(mem.fd, out); });
-      out.ok = 1;
-    } catch (const std::exception& e) {
-      out.ok = dynamic_cast<const InputError*>(&e) ? 0 : -1;
-      std::snprintf(out.message, sizeof(out.message), "%s", oneLine(e.what()).c_str());
-    }
-    // The record goes last: a child that dies before this leaves no magic behind.
-    if (::pwrite(mem.fd, &out, sizeof(out), 0) != ssize_t(sizeof(out))) ::_exit(3);
-    ::_exit(0);
-  }
-
-  // A healthy read takes well under a second for these files; the limit is for pathological ones.
-  std::error_code ec;
-  const uintmax_t size = fs::file_size(path, ec);
-  const double limitS = 120.0 + double(ec ? 0 : size) / 5e6;
-  const auto start = std::chrono::steady_clock::now();
-  int status = 0;
-  for (useconds_t nap = 100;; nap = std::min<useconds_t>(nap * 2, 20000)) {
-    const pid_t r = ::waitpid(pid, &status, WNOHANG);
-    if (r == pid) break;
-    if (r < 0 && errno != EINTR) throw inputError(path, "grid", cannot + " (lost the reader process)");
-    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > limitS) {
-      ::kill(pid, SIGKILL);
-      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-      }
-      throw inputError(path, "grid", cannot + " (reading took more than " + std::to_string(int(limitS)) +
-                                         " s: the file is probably corrupt)");
-    }
-    ::usleep(nap);
-  }
-  if (WIFSIGNALED(status)) {
-    throw inputError(path, "grid", cannot + " (the file is corrupt: OpenVDB's reader crashed on it, " +
-                                       strsignal(WTERMSIG(status)) + ")");
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
-      ::pread(mem.fd, &rec, sizeof(rec), 0) != ssize_t(sizeof(rec)) || rec.magic != kRecordMagic) {
-    throw inputError(path, "grid", cannot + " (the reader process failed)");
-  }
-  rec.message[sizeof(rec.message) - 1] = '\0';
-  if (rec.ok == 0) throw InputError(rec.message);
-  if (rec.ok != 1) throw inputError(path, "grid", cannot + " (" + rec.message + ")");
-  return true;
-}
-
 bool decodeInChild(const std::string& path, const std::string& gridName, DenseGrid& out) {
   const std::string cannot = "cannot read " + quoted(gridName);
   Fd mem;
@@ -472,27 +350,6 @@ bool decodeInChild(const std::string& path, const std::string& gridName, DenseGr
     done += n;
   }
   ::munmap(map, size_t(st.st_size));
-  return true;
-}
-
-// Runs produce() in a child (runInChild) and passes the text it returns back into *text; false
-// when no child can be used. `cannot` words the failures ("cannot list the grids").
-template <typename Produce>
-bool textInChild(const std::string& path, const std::string& cannot, Produce&& produce, std::string* text) {
-  Fd mem;
-  ChildRecord rec{};
-  auto work = [&](int fd, ChildRecord& result) {
-    const std::string out = produce();
-    result.payloadBytes = uint32_t(out.size());
-    if (::pwrite(fd, out.data(), out.size(), off_t(kDataOffset)) != ssize_t(out.size())) {
-      throw std::runtime_error(cannot + ": cannot pass the result back");
-    }
-  };
-  if (!runInChild(path, cannot, work, mem, rec)) return false;
-  text->assign(rec.payloadBytes, '\0');
-  if (::pread(mem.fd, text->data(), text->size(), off_t(kDataOffset)) != ssize_t(text->size())) {
-    throw inputError(path, "grid", cannot + " (the reader process returned an inconsistent result)");
-  }
   return true;
 }
 
@@ -569,153 +426,6 @@ DenseGrid loadVdb(const std::string& path, const std::string& gridName) {
   }
   checkDensityValues(out, "grid", quoted(gridName) + " has ");
   return out;
-}
-
-namespace {
-
-// The grid's metadata, then the file (atomically).
-void finishAndWrite(const std::string& path, openvdb::FloatGrid::Ptr vdb, const std::string& gridName, float voxelSize) {
-  vdb->setName(gridName);
-  vdb->setGridClass(openvdb::GRID_FOG_VOLUME);
-  vdb->setTransform(openvdb::math::Transform::createLinearTransform(double(voxelSize)));
-  vdb->insertMeta("creator", openvdb::StringMetadata("narval"));
-  writeGrids(path, {vdb});
-}
-
-}  // namespace
-
-void writeVdbSlabs(const std::string& path, int nx, int ny, int nz, int slabSlices,
-                   const std::function<void(int, int, float*)>& fill, const std::string& gridName, float voxelSize) {
-  initOpenVdb();
-  if (nx < 1 || ny < 1 || nz < 1 || slabSlices < 8 || slabSlices % 8 != 0)
-    throw std::invalid_argument("writeVdbSlabs: bad dimensions or slab depth (a positive multiple of 8)");
-  if (!(voxelSize > 0.0f) || !std::isfinite(voxelSize)) {
-    throw std::invalid_argument("writeVdb: voxel size must be positive and finite");
-  }
-  openvdb::FloatGrid::Ptr vdb = openvdb::FloatGrid::create(0.0f);
-  const size_t slice = size_t(nx) * size_t(ny);
-  std::vector<float> slab(slice * size_t(std::min(slabSlices, nz)));
-  // Slabs start at multiples of 8 slices: every leaf node (8³ voxels from index 0) lies in one
-  // slab, so copyFromDense builds each leaf whole, as it does from the whole grid.
-  for (int z0 = 0; z0 < nz; z0 += slabSlices) {
-    const int z1 = std::min(nz, z0 + slabSlices);
-    fill(z0, z1, slab.data());
-    const size_t n = slice * size_t(z1 - z0);
-    const size_t nans = size_t(std::count_if(slab.begin(), slab.begin() + long(n), [](float v) { return std::isnan(v); }));
-    if (nans > 0) throw std::invalid_argument("writeVdb: the grid holds " + std::to_string(nans) + " NaN values");
-    const openvdb::CoordBBox bbox(openvdb::Coord(0, 0, z0), openvdb::Coord(nx - 1, ny - 1, z1 - 1));
-    const openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, slab.data());
-    openvdb::tools::copyFromDense(dense, *vdb, /*tolerance=*/0.0f, /*serial=*/false);
-  }
-  finishAndWrite(path, vdb, gridName, voxelSize);
-}
-
-void writeVdb(const std::string& path, const DenseGrid& grid, const std::string& gridName, float voxelSize) {
-  initOpenVdb();
-  if (grid.nx < 0 || grid.ny < 0 || grid.nz < 0 || grid.data.size() != grid.voxelCount()) {
-    throw std::invalid_argument("writeVdb: grid dimensions " + dimsString(grid.nx, grid.ny, grid.nz) +
-                                " do not match its " + std::to_string(grid.data.size()) + " values");
-  }
-  // copyFromDense would turn NaN into inactive background (|NaN - 0| <= 0 is false either way):
-  // refuse it instead of silently changing the data.
-  const size_t nans = size_t(std::count_if(grid.data.begin(), grid.data.end(), [](float v) { return std::isnan(v); }));
-  if (nans > 0) throw std::invalid_argument("writeVdb: the grid holds " + std::to_string(nans) + " NaN values");
-  if (!(voxelSize > 0.0f) || !std::isfinite(voxelSize)) {
-    throw std::invalid_argument("writeVdb: voxel size must be positive and finite");
-  }
-  openvdb::FloatGrid::Ptr vdb = openvdb::FloatGrid::create(0.0f);
-  if (grid.voxelCount() > 0) {
-    const openvdb::CoordBBox bbox(openvdb::Coord(0, 0, 0), openvdb::Coord(grid.nx - 1, grid.ny - 1, grid.nz - 1));
-    // Dense only reads through this pointer (copyFromDense takes it const).
-    const openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, const_cast<float*>(grid.data.data()));
-    openvdb::tools::copyFromDense(dense, *vdb, /*tolerance=*/0.0f, /*serial=*/false);
-  }
-  finishAndWrite(path, vdb, gridName, voxelSize);
-}
-
-void writeVdbTestFile(const std::string& path, const std::string& kind) {
-  initOpenVdb();
-  openvdb::GridPtrVec grids;
-  if (kind == "vec3") {
-    openvdb::Vec3SGrid::Ptr v = openvdb::Vec3SGrid::create();
-    v->tree().setValue(openvdb::Coord(1, 2, 3), openvdb::Vec3s(1, 0, 0));
-    v->setName("velocity");
-    grids.push_back(v);
-    openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
-    f->tree().setValue(openvdb::Coord(0, 0, 0), 1.0f);
-    f->setName("heat");
-    grids.push_back(f);
-  } else if (kind == "emission") {
-    // Density "smoke": voxels (0..7)³ = 0.5 at voxel size 1. Emission "heat": voxel size 0.5,
-    // translated by (−1, −1, −1), voxels −1..20 on each axis holding 100 + 10x + 20y + 30z of
-    // their world centre (x, y, z), a field trilinear filtering reproduces exactly; its box
-    // covers the smoke's with a voxel to spare. And a Vec3 grid "velocity".
-    openvdb::FloatGrid::Ptr smoke = openvdb::FloatGrid::create(0.0f);
-    for (int z = 0; z < 8; ++z)
-      for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) smoke->tree().setValue(openvdb::Coord(x, y, z), 0.5f);
-    smoke->setName("smoke");
-    grids.push_back(smoke);
-    openvdb::FloatGrid::Ptr heat = openvdb::FloatGrid::create(0.0f);
-    openvdb::math::Transform::Ptr xf = openvdb::math::Transform::createLinearTransform(0.5);
-    xf->postTranslate(openvdb::Vec3d(-1, -1, -1));
-    heat->setTransform(xf);
-    for (int k = -1; k <= 20; ++k)
-      for (int j = -1; j <= 20; ++j)
-        for (int i = -1; i <= 20; ++i) {
-          const openvdb::Vec3d w = xf->indexToWorld(openvdb::Coord(i, j, k));
-          heat->tree().setValue(openvdb::Coord(i, j, k), float(100 + 10 * w.x() + 20 * w.y() + 30 * w.z()));
-        }
-    heat->setName("heat");
-    grids.push_back(heat);
-    openvdb::Vec3SGrid::Ptr v = openvdb::Vec3SGrid::create();
-    v->tree().setValue(openvdb::Coord(1, 2, 3), openvdb::Vec3s(1, 0, 0));
-    v->setName("velocity");
-    grids.push_back(v);
-  } else if (kind == "frustum") {
-    openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
-    f->tree().setValue(openvdb::Coord(1, 1, 1), 1.0f);
-    f->setName("density");
-    const openvdb::BBoxd box(openvdb::Vec3d(0, 0, 0), openvdb::Vec3d(10, 10, 10));
-    f->setTransform(openvdb::math::Transform::createFrustumTransform(box, 0.5, 10.0, 1.0));
-    grids.push_back(f);
-  } else if (kind == "huge") {
-    openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
-    f->tree().setValue(openvdb::Coord(-10, -10, -10), 1.0f);
-    f->tree().setValue(openvdb::Coord(2037, 2037, 2037), 1.0f);
-    f->setName("density");
-    grids.push_back(f);
-  } else if (kind == "empty") {
-    openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
-    f->setName("density");
-    grids.push_back(f);
-  } else if (kind == "invalid") {
-    openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
-    f->tree().setValue(openvdb::Coord(0, 0, 0), 1.0f);
-    f->tree().setValue(openvdb::Coord(1, 0, 0), std::numeric_limits<float>::quiet_NaN());
-    f->tree().setValue(openvdb::Coord(2, 0, 0), -1.0f);
-    f->tree().setValue(openvdb::Coord(3, 0, 0), std::numeric_limits<float>::infinity());
-    f->setName("density");
-    grids.push_back(f);
-  } else if (kind == "affine") {
-    // Voxels (3,4,5)..(4,6,8) with value x + 10y + 100z, under rotate(30 deg about z) * scale(2,3,4)
-    // then translate(1,2,3): world = M * ijk + t with M = R * S.
-    openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
-    for (int z = 5; z <= 8; ++z)
-      for (int y = 4; y <= 6; ++y)
-        for (int x = 3; x <= 4; ++x) f->tree().setValue(openvdb::Coord(x, y, z), float(x + 10 * y + 100 * z));
-    openvdb::Mat4d m = openvdb::Mat4d::identity();
-    m.preScale(openvdb::Vec3d(2, 3, 4));
-    m.postRotate(openvdb::math::Z_AXIS, M_PI / 6.0);
-    m.postTranslate(openvdb::Vec3d(1, 2, 3));
-    f->setTransform(openvdb::math::Transform::createLinearTransform(m));
-    f->setName("density");
-    grids.push_back(f);
-  } else {
-    throw std::invalid_argument("writeVdbTestFile: unknown kind '" + kind + "'");
-  }
-  for (auto& g : grids) g->setGridClass(openvdb::GRID_FOG_VOLUME);
-  writeGrids(path, grids);
 }
 
 }  // namespace narval

@@ -4,7 +4,7 @@
 // separated by any whitespace (any line breaks). The input is read in 1 MiB chunks; the header is
 // checked against limits and the input's size before anything is allocated. loadVol opens the file
 // and calls parseVol, which reads any seekable stream (the fuzzer and tests use bytes in memory).
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 #include <algorithm>
 #include <cctype>
@@ -21,7 +21,7 @@
 #include <string_view>
 #include <vector>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 
 namespace narval {
 namespace {
@@ -156,6 +156,41 @@ bool parseDim(std::string_view tok, uint64_t& v) {
   return v > 0;
 }
 
+// The header's checks (line 1: three positive integers, a count within the limit and the file's
+// size); returns the sizes as declared ("XxYxZ", as written) for messages.
+std::string checkVolHeader(const std::string& path, const std::vector<std::string>& header, bool headerOk,
+                           const uint64_t dims[3], uint64_t fileSize) {
+  if (!headerOk) {
+    std::string found;
+    for (const std::string& h : header) found += (found.empty() ? "" : " ") + h;
+    throw inputError(path, "line 1",
+                     "expected the header 'X Y Z' (three positive integers), found " +
+                         (header.empty() ? std::string(fileSize == 0 ? "an empty file" : "an empty line")
+                                         : "'" + found + "'"));
+  }
+  const std::string declared = header[0] + "x" + header[1] + "x" + header[2];
+  const uint64_t count = dims[0] * dims[1] * dims[2];  // may wrap when over the limit: used only below it
+  const bool overLimit = dims[0] > kMaxVolValues || dims[1] > kMaxVolValues || dims[2] > kMaxVolValues ||
+                         dims[0] * dims[1] > kMaxVolValues || count > kMaxVolValues;
+  if (overLimit) {
+    // The count is shown when it fits comfortably in 64 bits (each field below 2^21).
+    constexpr uint64_t kShowable = uint64_t(1) << 21;
+    const std::string n = (dims[0] < kShowable && dims[1] < kShowable && dims[2] < kShowable)
+                              ? " = " + std::to_string(count)
+                              : "";
+    throw inputError(path, "line 1",
+                     "header declares " + declared + n + " values, over the limit of " +
+                         std::to_string(kMaxVolValues) + " (2^30)");
+  }
+  if (count * 2 > fileSize) {
+    throw inputError(path, "line 1",
+                     "header declares " + declared + " = " + std::to_string(count) +
+                         " values, but the file has only " + std::to_string(fileSize) +
+                         " bytes (each value needs at least 2)");
+  }
+  return declared;
+}
+
 }  // namespace
 
 void checkDensityValues(DenseGrid& grid, const std::string& key, const std::string& subject) {
@@ -235,35 +270,8 @@ DenseGrid parseVol(std::istream& in, const std::string& path, size_t chunkBytes)
     if (header.size() < 6) header.emplace_back(showToken(tok, tooLong));
     else header.back() = "...";
   }
-  headerOk = headerOk && headerTokens == 3;
-  if (!headerOk) {
-    std::string found;
-    for (const std::string& h : header) found += (found.empty() ? "" : " ") + h;
-    throw inputError(path, "line 1",
-                     "expected the header 'X Y Z' (three positive integers), found " +
-                         (header.empty() ? std::string(fileSize == 0 ? "an empty file" : "an empty line")
-                                         : "'" + found + "'"));
-  }
-  const std::string declared = header[0] + "x" + header[1] + "x" + header[2];
-  const uint64_t count = dims[0] * dims[1] * dims[2];  // may wrap when over the limit: used only below it
-  const bool overLimit = dims[0] > kMaxVolValues || dims[1] > kMaxVolValues || dims[2] > kMaxVolValues ||
-                         dims[0] * dims[1] > kMaxVolValues || count > kMaxVolValues;
-  if (overLimit) {
-    // The count is shown when it fits comfortably in 64 bits (each field below 2^21).
-    constexpr uint64_t kShowable = uint64_t(1) << 21;
-    const std::string n = (dims[0] < kShowable && dims[1] < kShowable && dims[2] < kShowable)
-                              ? " = " + std::to_string(count)
-                              : "";
-    throw inputError(path, "line 1",
-                     "header declares " + declared + n + " values, over the limit of " +
-                         std::to_string(kMaxVolValues) + " (2^30)");
-  }
-  if (count * 2 > fileSize) {
-    throw inputError(path, "line 1",
-                     "header declares " + declared + " = " + std::to_string(count) +
-                         " values, but the file has only " + std::to_string(fileSize) +
-                         " bytes (each value needs at least 2)");
-  }
+  const std::string declared = checkVolHeader(path, header, headerOk && headerTokens == 3, dims, fileSize);
+  const uint64_t count = dims[0] * dims[1] * dims[2];
 
   DenseGrid grid;
   grid.nx = int(dims[0]);

@@ -5,7 +5,7 @@
  *                                                        `flames`; 1 without a grid)
  *   EMISSION_BLACKBODY  scale · B((v(x) − offset) · s)  (v: a temperature grid; pbrt-v4's
  *                                                        temperatureoffset / temperaturescale)
- * B is the blackbody colour of host/render/blackbody.h (peak-normalised Planck spectrum through the
+ * B is the blackbody colour of host/colour/blackbody.h (peak-normalised Planck spectrum through the
  * CIE 1931 matching functions into linear sRGB, 0 at or below 100 K), tabulated by the host over
  * [0, table_max] kelvin, table_max at least the hottest temperature the grid can give, and read
  * with linear interpolation: the table is interpolated, not the colour per voxel, so B follows the

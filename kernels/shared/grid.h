@@ -24,15 +24,15 @@
  *   (1-a)(1-b)(1-c)·T000 + a(1-b)(1-c)·T100 + ... (the OpenCL spec's form, which PoCL computes in
  *   float). grid_trilinear computes the same a, b, c and nests three lerps instead. Both are sums
  *   of non-negative terms, so each is within a few float roundings of the exact value relative to
- *   the result: on PoCL image and buffer agree within 16 ε of the density, ε = 2^-24 (measured:
- *   5 ε; tests/device/grid_storage_lookup_test.cpp), and the buffer on the device matches the
- *   host bit for bit. Rendered pixels: tests/render/grid_storage_test.cpp.
+ *   the result: on PoCL image and buffer agree within 16 ε of the density, ε = 2^-24
+ *   (tests/device/grid_storage_lookup_test.cpp; the gap measured: bench/RESULTS.md), and the
+ *   buffer on the device matches the host bit for bit. Rendered pixels: tests/render/grid_storage_test.cpp.
  * - Many GPUs (NVIDIA among them; CUDA's texture units store a, b, c in 9-bit fixed point with 8
  *   fractional bits) quantise the weights to multiples of 1/256: a lookup may then be off by up to
- *   1/256 of the difference between neighbouring voxels along each axis (an H100 was measured at
- *   0.0079 of the eight corners' range, against 3/256 = 0.0117). The buffer is exact float
- *   arithmetic on every device (bit for bit the host's, on PoCL and on that H100); the image is
- *   still the right choice on GPUs: there it did 1.8-2.7x the buffer's lookups per second.
+ *   1/256 of the difference between neighbouring voxels along each axis, 3/256 of the eight
+ *   corners' range in all (an H100's error: bench/RESULTS.md). The buffer is exact float
+ *   arithmetic on every device (bit for bit the host's, on PoCL and on an H100); the image is
+ *   still the right choice on GPUs, where it does more lookups per second (bench/RESULTS.md).
  * - The coordinate is clamped to [-1, 1e7] first: clamp addressing sends huge or infinite
  *   coordinates to the wrong edge on some devices (DESIGN.md), and here it keeps the int
  *   conversions defined. -1 is outside the grid by more than half a voxel: density 0. */
@@ -84,7 +84,7 @@ static inline float grid_trilinear(NV_GLOBAL const float* data, int nx, int ny, 
     /* All eight corners inside (almost every lookup): one base address and fixed strides, the
      * same products and sums as below (weights 1 - a and a), so the same bits. The slice stride
      * nx·ny fits an int (the host refuses larger slices); the base is size_t for big grids.
-     * Measured 1.2-1.3x the lookups/s of the general path alone on PoCL, 1.0-1.15x on an H100. */
+     * Why: more lookups per second than the general path alone (bench/RESULTS.md). */
     const int sy = nx, sz = nx * ny;
     NV_GLOBAL const float* b = data + ((size_t)x0 + (size_t)sy * (size_t)y0 + (size_t)sz * (size_t)z0);
     return grid_trilinear_combine(b[0], b[1], b[sy], b[sy + 1], b[sz], b[sz + 1], b[sz + sy], b[sz + sy + 1],
@@ -103,7 +103,7 @@ static inline float grid_trilinear(NV_GLOBAL const float* data, int nx, int ny, 
                                 wx0, wx1, wy0, wy1, wz0, wz1);
 }
 
-/* Sparse bricks (-D GRID_STORAGE_BRICKS; issue 6, item 6: grids beyond one image or buffer).
+/* Sparse bricks (-D GRID_STORAGE_BRICKS: grids beyond one image or buffer).
  * The grid is cut into bricks of GRID_BRICK³ voxels, brick (bx, by, bz) owning voxels
  * [8bx, 8bx + 7] × ... A brick stores GRID_BRICK_STORED³ = 9³ values: its own voxels and a
  * one-voxel apron on the + side of each axis (voxels 8bx + 8, the first layer of the next brick;

@@ -5,7 +5,7 @@
  * the light (march_light_column: a point light; a rectangle's centre, or with shadow_area_samples
  * K > 1 its effective column over K×K points of its area).
  *
- * Layout: a node grid over the medium's box (node_grid.h, realtime_params.light_cache), one slab
+ * Layout: a node grid over the medium's box (node_grid.h; the light_cache kernel argument), one slab
  * of nodes per light, the slabs one after the other.
  *
  * What a node stores: C = Σ_k ρ(x_k)·Δ, march_column_density from the node towards the light with
@@ -23,7 +23,7 @@
  * with a kink for a light inside (C = |x − light|); tests/unit/light_cache_test.cpp checks both.
  * Cost: one lookup (8 loads) replaces shadow_steps density lookups and a DDA walk per shadow ray.
  *
- * Built once per light on the device (kernels/light_cache.cl, host/render/light_cache.h), rebuilt
+ * Built once per light on the device (kernels/light_cache.cl, host/render/device_light_cache.h), rebuilt
  * only when the medium, that light or the shadow step count changes. */
 #ifndef NARVAL_LIGHT_CACHE_H
 #define NARVAL_LIGHT_CACHE_H
@@ -36,7 +36,7 @@
  * over its K×K points); 0 when the light sits on the node (nothing lies between).
  * Status word: STATUS_NAN for a NaN node point or column; STATUS_ITERATION_CAP from a DDA walk. */
 static inline float light_cache_build_node(KERNEL_CONTEXT_PARAM,
-                                           NV_CONSTANT const node_grid_params* c, int shadow_steps, int K,
+                                           NV_PRIVATE const node_grid_params* c, int shadow_steps, int K,
                                            int weighting, NV_CONSTANT const light_params* l, int node) {
   NV_CONSTANT const medium_params* m = ctx->medium;
   NV_PRIVATE uint* status = &ctx->status;
@@ -52,7 +52,7 @@ static inline float light_cache_build_node(KERNEL_CONTEXT_PARAM,
 
 /* Column density to light `light` at index-space point p inside the box [0, dims]: trilinear over
  * the slab's nodes. */
-static inline float light_cache_column_at(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
+static inline float light_cache_column_at(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache,
                                           int light, vec3 dims, vec3 p) {
   return node_grid_interpolate(c, cache + (size_t)light * (size_t)node_grid_count(c), 1, node_grid_locate(c, dims, p));
 }
@@ -61,7 +61,7 @@ static inline float light_cache_column_at(NV_CONSTANT const node_grid_params* c,
  * The density is 0 outside the box, so the shadow ray's column is that of the point where it
  * enters the box (x itself when x is inside): a point outside reads the box's face, never an
  * extrapolation, and a shadow ray that misses the box has column 0. */
-static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_CONSTANT const node_grid_params* c,
+static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_PRIVATE const node_grid_params* c,
                                        NV_GLOBAL const float* cache, int light, vec3 x, vec3 dir, float dist,
                                        NV_PRIVATE uint* status) {
   const vec3 dims = vec3_from4(m->dims);
@@ -77,20 +77,20 @@ static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_CO
  * channel: one cache lookup when the cache is on, else the exact shadow march of shadow_steps
  * samples (the kernels' pixels before the cache, bit for bit). Both real-time kernels call this
  * for every shadow ray. */
-static inline vec3 light_cache_optical_depth(KERNEL_CONTEXT_PARAM,
-                                             NV_CONSTANT const realtime_params* rp, NV_GLOBAL const float* cache,
+static inline vec3 light_cache_optical_depth(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
+                                             NV_PRIVATE const node_grid_params* lc, NV_GLOBAL const float* cache,
                                              int light, vec3 x, vec3 dir, float dist, vec3 view_dir) {
   NV_CONSTANT const light_params* lights = ctx->lights;
   NV_CONSTANT const medium_params* m = ctx->medium;
   NV_PRIVATE uint* status = &ctx->status;
   const vec3 sigma_t_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
-  if (rp->light_cache.nx > 0)
-    return vec3_scale(sigma_t_unit, light_cache_column(m, &rp->light_cache, cache, light, x, dir, dist, status));
-  if (rp->shadow_area_samples > 1 && light_has_area(&lights[light])) /* the columns the cache would hold */
+  if (lc->nx > 0)
+    return vec3_scale(sigma_t_unit, light_cache_column(m, lc, cache, light, x, dir, dist, status));
+  if (mp->shadow_area_samples > 1 && light_has_area(&lights[light])) /* the columns the cache would hold */
     return vec3_scale(sigma_t_unit,
-                      march_light_column(KERNEL_CONTEXT_ARG, &lights[light], x, rp->shadow_area_samples,
-                                         rp->shadow_steps, rp->shadow_weighting, view_dir));
-  return march_optical_depth(KERNEL_CONTEXT_ARG, x, dir, dist, rp->shadow_steps);
+                      march_light_column(KERNEL_CONTEXT_ARG, &lights[light], x, mp->shadow_area_samples,
+                                         mp->shadow_steps, mp->shadow_weighting, view_dir));
+  return march_optical_depth(KERNEL_CONTEXT_ARG, x, dir, dist, mp->shadow_steps);
 }
 
 #endif

@@ -4,7 +4,7 @@
  *   L = L_b · (1/n) Σ_i Tr(x0 → P_i)
  *     + albedo ⊙ Σ_k (1/n) Σ_i p(cos θ_i) · Tr(P_i → light_k) · I_k / |light_k − P_i|²
  *
- * Parameters (realtime_params, structs.h; scene keys renderer.lobe.*):
+ * Parameters (march_params and lobe_params, structs.h; scene keys renderer.lobe.*):
  *   steps             samples of the first-hit search over the view ray's segment in the box
  *                     (firstHitSteps, default 60), then LOBE_BISECTIONS bisection steps
  *   shadow_steps      midpoint samples of each transmittance to a light (shadowSteps, default 100):
@@ -12,8 +12,8 @@
  *   view_steps        midpoint samples of each Tr(x0 → P_i) (viewSteps)
  *   min_transmittance Tr(x0 → P_i) stops once below it in every channel (minTransmittance)
  *   depth_factor      lobe centre depth in mean free paths of unit density (default 20)
- *   lobe_radius       |P_i − c| in world units (default 1)
- *   lobe_points       n, the directions in `dirs` (default 30)
+ *   radius            |P_i − c| in world units (default 1)
+ *   points            n, the directions in `dirs` (default 30)
  *
  * 1. x0: the first point of the view ray inside the box where the density is above zero. The
  *    search takes `steps` midpoint samples over the occupied majorant cells only (march_iter) and
@@ -77,11 +77,11 @@
  *     of its first interaction, ∫ t σt T dt / ∫ σt T dt. Eq. 7's depth_factor/σ̄t measures depth
  *     with unit density, so in a thin wisp or a dense core c lands where nothing scatters (the
  *     black core and white ring on the default cloud); weighting by S as well matters where the
- *     light comes from behind (back-lit Disney cloud: JND 17.2% → 15.9% against a 256-spp
- *     reference). t_c lies between the entry and the last sample with density (a weighted mean of
- *     sample positions), inside the box; first-hit search and depth_factor are not used. Early termination as in step 4: the march stops once every channel's τ exceeds
- *     −ln ε'; the samples left carry weight below ε' together, so 1 − T_v is off by less than ε'
- *     (relative error of the in-scattered term below ε'/(1 − ε')).
+ *     light comes from behind (the back-lit Disney cloud, bench/RESULTS.md). t_c lies between the
+ *     entry and the last sample with density (a weighted mean of sample positions), inside the box;
+ *     first-hit search and depth_factor are not used. Early termination as in step 4: the march
+ *     stops once every channel's τ exceeds −ln ε'; the samples left carry weight below ε' together,
+ *     so 1 − T_v is off by less than ε' (relative error of the in-scattered term below ε'/(1 − ε')).
  * C3. Scale: lobe_radius is in mean free paths of unit density, r = lobe_radius/σ̄t. Scaling the
  *     geometry by s and σ by 1/s scales r, t_c and every segment by s and leaves every optical
  *     depth, T_v, phase angle and (for rectangle lights, I ∝ area) I/d² unchanged: the same image.
@@ -162,8 +162,8 @@ static inline vec3 lobe_transmittance_between(KERNEL_CONTEXT_PARAM, vec3 a, vec3
 /* Adds to *in_sum the light of every light at lobe point P scattered towards c (direction −d, d the
  * lobe direction that placed P): Σ_k p(cos θ) · Tr(P → light_k) · I_k / |light_k − P|². Terms are
  * added light by light into *in_sum, the order Eq. 7's pixels were recorded with. */
-static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* p,
-                                        NV_GLOBAL const float* light_cache, vec3 P, vec3 d, NV_PRIVATE vec3* in_sum) {
+static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
+                                        NV_PRIVATE const node_grid_params* lc, NV_GLOBAL const float* light_cache, vec3 P, vec3 d, NV_PRIVATE vec3* in_sum) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
   NV_PRIVATE uint* status = &ctx->status;
@@ -174,11 +174,11 @@ static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
     if (!light_view_from(&lights[k], P, &v)) continue;
     const vec3 to_light = v.dir;
     const vec3 tr =
-        vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, p, light_cache, k, P, to_light, v.dist, d));
-    if (p->area_light_samples > 1 || p->area_light_phase != AREA_LIGHT_POINTS) {
+        vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, mp, lc, light_cache, k, P, to_light, v.dist, d));
+    if (mp->area_light_samples > 1 || mp->area_light_phase != AREA_LIGHT_POINTS) {
       /* rectangles as K×K points or integrated exactly (march_light_phase) */
-      *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase(&lights[k], P, m->phase, d, p->area_light_phase,
-                                                                  p->area_light_samples)));
+      *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase(&lights[k], P, m->phase, d, mp->area_light_phase,
+                                                                  mp->area_light_samples)));
       continue;
     }
     /* w_in: the light's propagation direction, light → P. */
@@ -205,36 +205,36 @@ static inline vec3 lobe_direction(vec3 tx, vec3 ty, vec3 dir, nv_float4 q) {
 }
 
 /* Eq. 7 (header comment, steps 1-4), bit for bit as the dissertation's reproduction records it. */
-static inline vec3 lobe_radiance_eq7(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* p,
-                                     NV_GLOBAL const nv_float4* dirs,
-                                     NV_GLOBAL const float* light_cache, vec3 origin, vec3 dir, vec3 tx, vec3 ty,
-                                     vec3 Lb, NV_PRIVATE const medium_segment* seg) {
+static inline vec3 lobe_radiance_eq7(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
+                                     NV_PRIVATE const lobe_params* lp, NV_PRIVATE const node_grid_params* lc,
+                                     NV_GLOBAL const nv_float4* dirs, NV_GLOBAL const float* light_cache, vec3 origin,
+                                     vec3 dir, vec3 tx, vec3 ty, vec3 Lb, NV_PRIVATE const medium_segment* seg) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const medium_params* m = &s->medium;
   /* 1. First hit. */
   float t_x0;
-  if (!lobe_first_hit(KERNEL_CONTEXT_ARG, seg, p->steps, &t_x0)) return Lb;
+  if (!lobe_first_hit(KERNEL_CONTEXT_ARG, seg, mp->steps, &t_x0)) return Lb;
   const vec3 x0 = vec3_madd(origin, dir, t_x0);
 
   /* 2. Lobe centre, depth clamped to the rest of the segment inside the box. */
   const float mean_sigma_t = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
   const float rest = seg->t1 - t_x0;
-  const float depth = p->depth_factor < mean_sigma_t * rest ? p->depth_factor / mean_sigma_t : rest;
+  const float depth = lp->depth_factor < mean_sigma_t * rest ? lp->depth_factor / mean_sigma_t : rest;
   const vec3 c = vec3_madd(x0, dir, depth);
 
   /* 4. Sums over the lobe points. */
-  const int n = p->lobe_points;
+  const int n = lp->points;
   const int view_term = !vec3_is_zero(Lb);
-  const float tau_limit = p->min_transmittance > 0.0f
-                              ? -nv_log(p->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
+  const float tau_limit = mp->min_transmittance > 0.0f
+                              ? -nv_log(mp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
                               : NV_INFINITY;
   vec3 tr_sum = vec3_splat(0.0f), in_sum = vec3_splat(0.0f);
   for (int i = 0; i < n; ++i) {
     const vec3 d = lobe_direction(tx, ty, dir, dirs[i]);
-    const vec3 P = vec3_madd(c, d, p->lobe_radius);
+    const vec3 P = vec3_madd(c, d, lp->radius);
     if (view_term)
-      tr_sum = vec3_add(tr_sum, lobe_transmittance_between(KERNEL_CONTEXT_ARG, x0, P, p->view_steps, tau_limit));
-    lobe_add_inscattered(KERNEL_CONTEXT_ARG, p, light_cache, P, d, &in_sum);
+      tr_sum = vec3_add(tr_sum, lobe_transmittance_between(KERNEL_CONTEXT_ARG, x0, P, lp->view_steps, tau_limit));
+    lobe_add_inscattered(KERNEL_CONTEXT_ARG, mp, lc, light_cache, P, d, &in_sum);
   }
   const float fn = (float)n;
   const vec3 tr_mean = vec3_make(tr_sum.x / fn, tr_sum.y / fn, tr_sum.z / fn);
@@ -259,7 +259,8 @@ static inline int lobe_ball_inside(NV_CONSTANT const medium_params* m, vec3 c, f
 }
 
 /* The corrected estimator (header comment, "Corrected"). */
-static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* p,
+static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
+                                           NV_PRIVATE const lobe_params* lp, NV_PRIVATE const node_grid_params* lc,
                                            NV_GLOBAL const nv_float4* dirs, NV_GLOBAL const float* light_cache,
                                            vec3 origin, vec3 dir, vec3 tx, vec3 ty, vec3 Lb,
                                            NV_PRIVATE const medium_segment* seg) {
@@ -269,10 +270,10 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_CONSTANT con
   /* C1-C2. One march of the view ray: its transmittance T_v and where its light is scattered,
    * t_c = Σ w_k S_k t_k / Σ w_k S_k with w_k = T(before k)·(1 − e^{−σ̄t,k Δ}) (channel means) and
    * S_k the lights' in-scattering at sample k (Σ w_k t_k / Σ w_k where no light reaches the ray). */
-  const float tau_limit = p->min_transmittance > 0.0f
-                              ? -nv_log(p->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
+  const float tau_limit = mp->min_transmittance > 0.0f
+                              ? -nv_log(mp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
                               : NV_INFINITY;
-  march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, p->view_steps);
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, lp->view_steps);
   *status |= it.status;
   vec3 tau = vec3_splat(0.0f);
   float w_sum = 0.0f, wt_sum = 0.0f, ws_sum = 0.0f, wst_sum = 0.0f, t;
@@ -280,7 +281,7 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_CONSTANT con
     const vec3 dtau = vec3_scale(march_sigma_t(KERNEL_CONTEXT_ARG, seg, t), it.delta);
     const float w = nv_exp(-vec3_average(tau)) * (1.0f - nv_exp(-vec3_average(dtau)));
     vec3 S = vec3_splat(0.0f);
-    if (w > 0.0f) lobe_add_inscattered(KERNEL_CONTEXT_ARG, p, light_cache, vec3_madd(origin, dir, t), dir, &S);
+    if (w > 0.0f) lobe_add_inscattered(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(origin, dir, t), dir, &S);
     const float ws = w * vec3_average(S);
     w_sum += w;
     wt_sum += w * t;
@@ -298,17 +299,16 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_CONSTANT con
 
   /* C3-C4. Lobe points at r = lobe_radius mean free paths of unit density, each pulled in to the
    * box's boundary along its own direction (no intersection needed when the whole ball of radius r
-   * about c is inside: lobe_ball_inside, a box intersection per point saved; 10% of the front-lit
-   * Disney cloud's frame, bench/RESULTS.md). */
-  const float r = p->lobe_radius / vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
-  const int n = p->lobe_points;
+   * about c is inside: lobe_ball_inside, a box intersection per point saved: bench/RESULTS.md). */
+  const float r = lp->radius / vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  const int n = lp->points;
   const int ball_inside = lobe_ball_inside(m, c, r);
   vec3 in_sum = vec3_splat(0.0f);
   for (int i = 0; i < n; ++i) {
     const vec3 d = lobe_direction(tx, ty, dir, dirs[i]);
     medium_segment inside;
     const float reach = ball_inside ? r : medium_intersect(m, c, d, 0.0f, r, &inside) ? inside.t1 : 0.0f;
-    lobe_add_inscattered(KERNEL_CONTEXT_ARG, p, light_cache, vec3_madd(c, d, reach), d, &in_sum);
+    lobe_add_inscattered(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(c, d, reach), d, &in_sum);
   }
   const float fn = (float)n;
   const vec3 in_mean = vec3_make(in_sum.x / fn, in_sum.y / fn, in_sum.z / fn);
@@ -334,29 +334,30 @@ static inline void lobe_frame(vec3 dir, vec3 right, NV_PRIVATE vec3* tx, NV_PRIV
 }
 
 /* Radiance of the view ray from `origin` along unit `dir`. `right` is the camera's unit right
- * vector (the lobe frame's reference, see the header comment); `dirs` holds p->lobe_points unit
+ * vector (the lobe frame's reference, see the header comment); `dirs` holds lp->points unit
  * directions about +Z. */
-static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* p,
-                                 NV_GLOBAL const nv_float4* dirs,
-                                 NV_GLOBAL const float* light_cache, vec3 origin, vec3 dir, vec3 right) {
+static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
+                                 NV_PRIVATE const lobe_params* lp, NV_PRIVATE const node_grid_params* lc,
+                                 NV_GLOBAL const nv_float4* dirs, NV_GLOBAL const float* light_cache, vec3 origin,
+                                 vec3 dir, vec3 right) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
   /* L_b, and the view ray stops at the first light surface it meets (they are opaque). */
   vec3 Lb;
   medium_segment seg;
-  if (!march_view(s, lights, origin, dir, &Lb, &seg) || p->lobe_points < 1) return Lb;
+  if (!march_view(s, lights, origin, dir, &Lb, &seg) || lp->points < 1) return Lb;
 
   /* 3. Frame (t, b, ω) from the camera's right vector; (t, b, ω) is right-handed. */
   vec3 tx, ty;
   lobe_frame(dir, right, &tx, &ty);
-  const int corrected = p->lobe_variant == LOBE_CORRECTED; /* else LOBE_EQ7, the host's only other variant */
+  const int corrected = lp->variant == LOBE_CORRECTED; /* else LOBE_EQ7, the host's only other variant */
   const vec3 L = corrected
-                     ? lobe_radiance_corrected(KERNEL_CONTEXT_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg)
-                     : lobe_radiance_eq7(KERNEL_CONTEXT_ARG, p, dirs, light_cache, origin, dir, tx, ty, Lb, &seg);
+                     ? lobe_radiance_corrected(KERNEL_CONTEXT_ARG, mp, lp, lc, dirs, light_cache, origin, dir, tx, ty, Lb, &seg)
+                     : lobe_radiance_eq7(KERNEL_CONTEXT_ARG, mp, lp, lc, dirs, light_cache, origin, dir, tx, ty, Lb, &seg);
 #ifdef EMISSION
   /* The medium's own light, marched with `steps` samples in both variants (the first-hit search's,
    * 60 by default): corrected's view march has view_steps = 16, which aliases a fire's flames. */
-  return vec3_add(L, march_emission(KERNEL_CONTEXT_ARG, &seg, p->steps, p->min_transmittance));
+  return vec3_add(L, march_emission(KERNEL_CONTEXT_ARG, &seg, mp->steps, mp->min_transmittance));
 #else
   return L;
 #endif
@@ -364,14 +365,14 @@ static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtim
 
 /* The pixel (px, py): ray through its centre (deterministic, no jitter). Non-finite results are
  * reported in *status and replaced by 0. */
-static inline vec3 lobe_pixel(KERNEL_CONTEXT_PARAM,
-                              NV_CONSTANT const realtime_params* p, NV_GLOBAL const nv_float4* dirs,
+static inline vec3 lobe_pixel(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp, NV_PRIVATE const lobe_params* lp,
+                              NV_PRIVATE const node_grid_params* lc, NV_GLOBAL const nv_float4* dirs,
                               NV_GLOBAL const float* light_cache, int px, int py) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
   const ray3 r = camera_pixel_centre_ray(&s->camera, px, py);
   return status_finite_or_zero(
-      status, lobe_radiance(KERNEL_CONTEXT_ARG, p, dirs, light_cache, r.origin, r.dir, vec3_from4(s->camera.right)));
+      status, lobe_radiance(KERNEL_CONTEXT_ARG, mp, lp, lc, dirs, light_cache, r.origin, r.dir, vec3_from4(s->camera.right)));
 }
 
 #endif

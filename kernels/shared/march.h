@@ -65,7 +65,7 @@ static inline vec3 march_light_phase_integral(NV_CONSTANT const light_params* l,
   return march_light_phase_sum(l, x, phase, view_dir, 1);
 }
 
-/* The real-time kernels' phase over a light (realtime_params.area_light_phase): K×K points
+/* The real-time kernels' phase over a light (march_params.area_light_phase): K×K points
  * (march_light_phase_sum) or the exact integral (march_light_phase_integral). */
 static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                      vec3 view_dir, int area_light_phase, int K) {

@@ -6,7 +6,7 @@
 #define NARVAL_MARCH_QUADRATURE_H
 
 #include "shared/grid.h"
-#include "shared/majorant.h"
+#include "shared/majorant_dda.h"
 #include "shared/medium.h"
 
 /* σt at world point o + t·d of a medium segment (index-space origin and direction in `seg`). */

@@ -25,7 +25,7 @@
  * lookup clamps a + g·(b·w_out) at 0 per channel (a truncated expansion can dip below). For an
  * isotropic phase function g = 0 and only R counts.
  *
- * Closure (ms_cache_closure, realtime_params.ms_cache_closure): what the two moments say about the
+ * Closure (ms_cache_params.closure): what the two moments say about the
  * in-scattering in a direction. MS_CACHE_CLOSURE_LINEAR is the truncated expansion above,
  * R·(1 + g·(b/R)·w_out) clamped at 0. It is exact for a field linear in w, but a field concentrated
  * along its mean direction, as dense clouds at g 0.8–0.9 hold (light scattered forwards a few
@@ -45,27 +45,26 @@
  * the weight p/pdf is 1), which the lookup returns as it is. Exact in direction up to w_c being
  * the node's and not the sample's (the camera far from the box: degrees apart), it is the same
  * estimator as the uniform one for an isotropic phase function, and it depends on where the camera
- * is: the host starts the cache over when the camera moves (render/ms_cache.cpp).
+ * is: the host starts the cache over when the camera moves (host/render/device_ms_cache.cpp).
  *
  * Interpolation: R is interpolated geometrically, exp(Σ w_k ln R_k) with the trilinear weights
  * w_k, and the moment per unit R, b/R, linearly. In a dense medium the radiance falls off
  * exponentially with depth (the Disney cloud at density 10 has a mean free path of a tenth of a
  * cache cell): a linear mix of a lit node and a node ten mean free paths deeper paints the deeper
- * one bright, in blocks the shape of the cells (mean ΔE76 6.0 on the Disney cloud against the
- * path-traced reference); the geometric mean is exact for an exponential along each axis (2.8).
+ * one bright, in blocks the shape of the cells (on the Disney cloud, against the path-traced
+ * reference: bench/RESULTS.md); the geometric mean is exact for an exponential along each axis.
  * It keeps every property the tests check: equal corners give that value, so the white furnace
  * stays 1, and for a smooth field it errs, like trilinear, at second order in the node spacing.
  * A node at 0 would pull the whole cell to 0, so R + floor is interpolated instead, floor =
  * MS_CACHE_LOG_FLOOR × the cell's largest R, and floor taken off after.
- * MS_CACHE_INTERPOLATION_LINEAR (realtime_params.ms_cache_interpolation) mixes R and b linearly
+ * MS_CACHE_INTERPOLATION_LINEAR (ms_cache_params.interpolation) mixes R and b linearly
  * instead (b/R = Σ w_k b_k / Σ w_k R_k): exact for a field linear along each axis, where the
  * geometric mean falls short of it (by the AM–GM inequality: 6% at the middle of two nodes a factor
- * 2 apart). Which is nearer depends on the medium: the default cloud, where the camera-aimed cache
- * varies gently, reads 4–5% dark throughout with the geometric mean (JND 9.3% → 8.5% with the
- * linear one, 32 cells, against an 8192-spp reference); the back-lit Disney cloud paints blocks with
- * the linear one (13.7% → 17.3%).
+ * 2 apart). Which is nearer depends on the medium (bench/RESULTS.md): the default cloud, where the
+ * camera-aimed cache varies gently, reads dark throughout with the geometric mean and nearer with
+ * the linear one; the back-lit Disney cloud paints blocks with the linear one.
  *
- * Direct (realtime_params.ms_cache_direct; closure camera or the view layout only): a node holds
+ * Direct (ms_cache_params.direct; closure camera or the view layout only): a node holds
  * the whole in-scattering towards the camera, the lights' unscattered light included, and the march
  * makes no light loop (no shadow rays, no light cache): a frame is the view march and one lookup per
  * sample. Each path treats its start as a scattering event of a camera path arriving along −w_c:
@@ -73,20 +72,19 @@
  * point lights included), and the emitter its first segment meets weighted against it by MIS
  * (pathtrace_radiance's first_phase_pdf), as at any event of a path-traced pixel. So the shadow
  * follows the phase's peak wherever it points (a cloud lit from behind: march.h,
- * march_light_column_phase) at the cost of the path tracer's variance. Measured on the back-lit
- * Disney cloud (view, tile 2, 512 paths): two cache seeds differ by JND 7.3% with the phase
- * sampling alone, 6.1% with the next-event estimate, for 35% more build time.
+ * march_light_column_phase) at the cost of the path tracer's variance. On the back-lit Disney
+ * cloud two cache seeds agree better with the next-event estimate than with the phase sampling
+ * alone, for more build time (bench/RESULTS.md).
  *
- * Guide (realtime_params.ms_cache_guide; closure camera or the view layout only): a share of each
+ * Guide (ms_cache_params.guide; closure camera or the view layout only): a share of each
  * path's first directions is drawn from HG lobes about the directions to the lights instead of
  * from the phase function about −w_c (phase_guide.h), the path weighted by phase/mixture density
  * and both MIS weights at its start using the mixture's density: the node's expectation is the
  * same. Where a cloud is lit from the camera's side, the light a node sends towards the camera
  * arrives mostly from the lights' side, which the phase function about −w_c points away from.
- * Measured on the front-lit Disney cloud (view, tile 4, 480 paths, direct, unfiltered): the
- * relMSE between two cache seeds 1.88e-3 unguided, 1.01e-3 at share 0.15 and lobes of g 0.6 (the
- * filtered tile-2 pick: 0.46e-3 → 0.29e-3 at the same build time); back-lit 0.85e-3 → 0.81e-3,
- * the default cloud 0.47e-3 → 0.42e-3 (bench/RESULTS.md).
+ * At share 0.15 and lobes of g 0.6 it lowers the relMSE between two cache seeds most on the
+ * front-lit Disney cloud (filtered too, at the same build time), a little on the back-lit one and
+ * the default cloud (bench/RESULTS.md).
  *
  * Storage: MS_CACHE_STRIDE floats per node: the running means of the paths so far, R (rgb) then
  * their count, then b for red, green and blue (xyz each, then a float: after red's the view layout's
@@ -183,7 +181,7 @@ static inline float ms_cache_mix_linear(NV_GLOBAL const float* cache, NV_PRIVATE
 /* The in-scattered radiance of the rest at index-space point p (inside the box [0, dims]) towards
  * w_out (the propagation direction after scattering), per unit σs: R over the cell's eight nodes
  * ("Interpolation", geometric or linear) times the closure's factor for g and b/R ("Closure"). */
-static inline vec3 ms_cache_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache, vec3 dims,
+static inline vec3 ms_cache_lookup(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache, vec3 dims,
                                    vec3 p, float g, int closure, int interpolation, vec3 w_out) {
   float w[8];
   size_t at[8];

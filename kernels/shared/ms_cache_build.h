@@ -12,10 +12,9 @@
 /* The stream the cache's paths draw from: the scene's seed offset, so that node n's paths never
  * share the numbers of pixel n's camera samples. */
 #define MS_CACHE_SEED_OFFSET 0x6d73u
-/* The guide lobes' HG parameter (phase_guide.h; ms_cache.h, "Guide"). On the front-lit Disney
- * cloud (g 0.9; view, tile 4, 480 paths), the relMSE between two cache seeds at the best share of
- * each: g 0.9 1.16e-3 (share 0.25), 0.6 1.01e-3 (0.15), 0.3 0.96e-3 (0.15), none 1.88e-3; 0.6
- * also on the back-lit one: 0.81e-3 at 0.15 against 0.85e-3 unguided. */
+/* The guide lobes' HG parameter (phase_guide.h; ms_cache.h, "Guide"), compared by the relMSE
+ * between two cache seeds, each g at its best share, on the front-lit Disney cloud (g 0.9) and
+ * checked on the back-lit one (bench/RESULTS.md). */
 #define MS_CACHE_GUIDE_G 0.6f
 
 /* The leading coordinates of node `node`'s path k: where in its slice it starts and which light its
@@ -23,16 +22,13 @@
  * the light (u[4], u[5]). The path's result varies smoothly with them (the phase's peak against a
  * wide light, the transmittance falling across the slice), so each pair is a scrambled Sobol
  * sequence over k (sobol_owen.h) rather than independent numbers: every power-of-two prefix of a
- * node's paths is stratified in each pair. Measured: the lit box of the render tests (HG 0.8, view
- * layout with the direct light) bounds its error at 11.7% of the value instead of 21.6% (rectangle
- * light) and 14.1% instead of 22.9% (point light); on the back-lit Disney cloud (view, tile 2,
- * 400 paths) two cache seeds' relative MSE falls from 1.13e-3 to 1.00e-3, and with the direct
- * light alone (bounces 1) from 4.3e-4 to 3.3e-4: there the paths' further bounces hold most of
- * the noise, and they draw at random (delta tracking takes as many numbers as it needs). Each
- * node scrambles with its own seeds (drawn once per launch from its own stream at sample index
- * MS_CACHE_LEADING_STREAM, which no path reaches), so nodes' errors stay independent and the cache
- * after K paths is the same whatever launches it was split into. The rest of a path draws from its
- * counter-based stream (rng.h). */
+ * node's paths is stratified in each pair. It tightens the error bound of the render tests' lit box
+ * and lowers two cache seeds' relative MSE on the back-lit Disney cloud, more with the direct light
+ * alone (bench/RESULTS.md): the paths' further bounces hold most of the noise, and they draw at
+ * random (delta tracking takes as many numbers as it needs). Each node scrambles with its own seeds
+ * (drawn once per launch from its own stream at sample index MS_CACHE_LEADING_STREAM, which no path
+ * reaches), so nodes' errors stay independent and the cache after K paths is the same whatever
+ * launches it was split into. The rest of a path draws from its counter-based stream (rng.h). */
 #define MS_CACHE_LEADING_STREAM 0xFFFFFFFFu
 #define MS_CACHE_LEADING_KEYS 9 /* three pairs: the index's seed, then each axis's */
 static inline void ms_cache_leading_keys(uint seed, int node, NV_PRIVATE uint* keys) {
@@ -75,24 +71,24 @@ static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int clo
  * against it by MIS, as at any event of a path-traced pixel. With the guide (ms_cache.h, "Guide")
  * the direction comes from phase_guide_sample instead, weighted by phase/mixture density, and the
  * mixture's density is the one both MIS weights name. */
-static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
+static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int node,
                                  NV_GLOBAL const float* v, vec3 x, NV_PRIVATE const uint* keys, uint k,
                                  NV_PRIVATE vec3* omega) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
-  const int view = rp->ms_cache_layout == MS_CACHE_LAYOUT_VIEW, direct = rp->ms_cache_direct;
-  const int closure = rp->ms_cache_closure; /* the camera closure in the view layout (the host sets it) */
+  const int view = mc->layout == MS_CACHE_LAYOUT_VIEW, direct = mc->direct;
+  const int closure = mc->closure; /* the camera closure in the view layout (the host sets it) */
   float u[6]; /* the leading coordinates, stratified over the node's paths ("Leading coordinates") */
   ms_cache_leading(keys, k, u);
   rng_state rng = rng_init(s->seed + MS_CACHE_SEED_OFFSET, (uint)node, k);
-  if (view) x = ms_view_sample_point(KERNEL_CONTEXT_ARG, rp, node, v, u[0]); /* in its slice */
+  if (view) x = ms_view_sample_point(KERNEL_CONTEXT_ARG, mc, node, v, u[0]); /* in its slice */
   float pdf;
   const vec3 w_c = ms_cache_to_camera(s, x);
   phase_guide gd = phase_guide_none();
   float weight = 1.0f; /* p/pdf of the direction (1 without a guide: sampling is exact) */
-  if (closure == MS_CACHE_CLOSURE_CAMERA && rp->ms_cache_guide > 0.0f) {
+  if (closure == MS_CACHE_CLOSURE_CAMERA && mc->guide > 0.0f) {
     gd.x = x;
-    gd.share = rp->ms_cache_guide;
+    gd.share = mc->guide;
     gd.g = MS_CACHE_GUIDE_G;
     float f;
     *omega = phase_guide_sample(ctx->lights, s->num_lights, s->medium.phase, vec3_scale(w_c, -1.0f), gd,
@@ -115,7 +111,7 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtim
  * widened by the cells' own padding, MAJORANT_SLACK) has a positive bound: the build skips the
  * others, the empty space around a cloud or a plume.
  * Without a majorant grid (the global majorant): every node. */
-static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_CONSTANT const node_grid_params* c, int node) {
+static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_PRIVATE const node_grid_params* c, int node) {
   NV_CONSTANT const medium_params* m = ctx->medium;
   const majorant_grid_params g = m->majorant_grid;
   if (g.cells_x <= 0 || g.cells_y <= 0 || g.cells_z <= 0) return 1;
@@ -138,13 +134,13 @@ static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
 /* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"), the
  * node at world point x: v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then
  * ln R and b/R. */
-static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, vec3 x,
+static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, vec3 x,
                                         int node, NV_GLOBAL float* v, uint first, uint count) {
   uint keys[MS_CACHE_LEADING_KEYS];
   ms_cache_leading_keys(ctx->scene->seed, node, keys);
   for (uint k = first; k < first + count; ++k) {
     vec3 omega;
-    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, rp, node, v, x, keys, k, &omega);
+    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, mc, node, v, x, keys, k, &omega);
     const float n = (float)(k + 1u);
     const float Lc[3] = {L.x, L.y, L.z};
     const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */
@@ -169,13 +165,13 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
  * for the cache's layout. A grid node no lookup reads is left at 0 (ms_cache_node_is_read); a view
  * node's slice is where ms_view_place_column put it, it takes no paths when its column holds no
  * medium, and none past its budget when it has one (MS_VIEW_BUDGET). */
-static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
+static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int node,
                                        NV_GLOBAL float* v, uint first, uint count) {
-  NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
-  switch (rp->ms_cache_layout) {
+  NV_PRIVATE const node_grid_params* c = &mc->grid;
+  switch (mc->layout) {
     case MS_CACHE_LAYOUT_GRID:
       if (ms_cache_node_is_read(KERNEL_CONTEXT_ARG, c, node))
-        ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp,
+        ms_cache_refine_node(KERNEL_CONTEXT_ARG, mc,
                              affine_point(c->index_to_world, node_grid_point(c, vec3_from4(ctx->medium->dims), node)),
                              node, v, first, count);
       return;
@@ -187,7 +183,7 @@ static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_CONSTANT const r
         if (first >= budget) return;
         count = budget - first < count ? budget - first : count;
       }
-      ms_cache_refine_node(KERNEL_CONTEXT_ARG, rp, vec3_splat(0.0f), node, v, first, count);
+      ms_cache_refine_node(KERNEL_CONTEXT_ARG, mc, vec3_splat(0.0f), node, v, first, count);
       return;
     }
     default: return; /* unknown: reported at the kernel's entry */

@@ -1,14 +1,13 @@
 /* ms_cache_filter.h: a filter over the view cache's nodes (ms_cache_view.h) that averages
- * neighbouring columns where they agree within their noise. A node's paths are few on a 60 s CPU
- * build (100–700 at 320x240), and their noise is most of the view cache's error; wider tiles
- * average more paths per pixel but mix columns whose in-scattering differs (at tile 2 the bilinear
- * mix alone leaves the back-lit Disney cloud at JND 5.1% with 8192 paths a node, tile 1 at 3.0%:
- * bench/RESULTS.md). What separates columns that may be mixed from those that may not is J itself:
- * a guide from the single scattering does not (in a cloud of albedo 0.99 most of J is multiple
- * scattering; the back-lit cloud's dark ring holds none at all), so the range distance is the
- * nodes' own difference measured in their noise, as in non-local-means filtering of Monte Carlo
- * renders (Rousselle, Knaus & Zwicker 2012, "Adaptive rendering with non-local means filtering",
- * Eq. 4), with the column's slices as the patch:
+ * neighbouring columns where they agree within their noise. A node's paths are few on an
+ * interactive CPU build, and their noise is most of the view cache's error; wider tiles average
+ * more paths per pixel but mix columns whose in-scattering differs (even with many paths a node,
+ * tile 2's bilinear mix alone errs more than tile 1: bench/RESULTS.md). What separates columns that
+ * may be mixed from those that may not is J itself: a guide from the single scattering does not (in
+ * a cloud of albedo 0.99 most of J is multiple scattering; the back-lit cloud's dark ring holds
+ * none at all), so the range distance is the nodes' own difference measured in their noise, as in
+ * non-local-means filtering of Monte Carlo renders (Rousselle, Knaus & Zwicker 2012, "Adaptive
+ * rendering with non-local means filtering", Eq. 4), with the column's slices as the patch:
  *
  *   d²_j = (1/nz) Σ_s max(0, (J_j,s − J_s)² − (v_s + v_j,s)) / (ε + k²·(v_s + v_j,s)),
  *
@@ -25,8 +24,8 @@
  *
  * over the columns j within max(1, ⌊2σ_s⌋) of it on each axis that hold medium, one weight per
  * column for all its slices. σ_s is in columns (msCache.filter; 0: off). A patch of the column's
- * slices rather than one node: the distance is less noisy, and measured it is better on two scenes
- * of three (bench/RESULTS.md). The weights depend on the noise, so the filter is biased where true
+ * slices rather than one node: the distance is less noisy, and it measured better on most
+ * scenes tried (bench/RESULTS.md). The weights depend on the noise, so the filter is biased where true
  * differences hide in it (the price of every such denoiser); k → ∞ is a plain Gaussian. The filter
  * reads the running means and writes a second buffer of the same layout (R filtered, the other
  * slots copied; the view lookup reads R alone), which the march reads; it runs after every build
@@ -41,9 +40,8 @@
  * 2S − S² that keeps more weight at the centre, so more of the noise. A second pass computes it
  * from the first pass's output (ms_view_filter_column with `residual` set), with the same weights,
  * and clamps it at 0 (radiance: where the field dips more sharply than a quadratic, 2S − S² can
- * overshoot below it). Measured on the back-lit Disney cloud (tile 1, 160 paths; the 8-bit reference
- * tiles): the filter alone reads the mid-dark bands (reference L* 5–50) +1.1 to +2.0 L* too bright
- * and JND 5.63%, twiced −0.7 to +0.3 and 5.55% at the same σ_s and k, 5.15% at σ_s 1.5 (bench/RESULTS.md). */
+ * overshoot below it). On the back-lit Disney cloud the filter alone reads the mid-dark bands too
+ * bright; twicing takes most of that out and lowers the JND (bench/RESULTS.md). */
 #ifndef NARVAL_MS_CACHE_FILTER_H
 #define NARVAL_MS_CACHE_FILTER_H
 
@@ -61,7 +59,7 @@ static inline float ms_view_grey_variance(NV_GLOBAL const float* v) {
 
 /* Column j's read over node (column, s)'s τ range, as ms_view_lookup reads one column, and the
  * variance of j's slice holding that range's midpoint. */
-static inline vec3 ms_view_filter_read(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
+static inline vec3 ms_view_filter_read(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache,
                                        NV_GLOBAL const float* v, int j, NV_PRIVATE float* variance) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
   NV_GLOBAL const float* col = cache + (size_t)j * MS_CACHE_STRIDE;
@@ -78,7 +76,7 @@ static inline vec3 ms_view_filter_read(NV_CONSTANT const node_grid_params* c, NV
  * from `cache`); a column without medium is copied. The weights come from `cache`, the running
  * means; the values averaged from `values`: the running means again (S(J)), or with `residual` set
  * the first pass's output F, and then the column gets 2·F − S(F), at least 0 ("Twicing"). */
-static inline void ms_view_filter_column(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
+static inline void ms_view_filter_column(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache,
                                          NV_GLOBAL const float* values, int residual, int column, float sigma_s,
                                          float tolerance, NV_GLOBAL float* out) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;

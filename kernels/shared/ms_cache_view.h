@@ -2,8 +2,8 @@
  * ms_cache.h holds what a node estimates and how). The grid layout spends its nodes evenly over the
  * medium's box; in a dense cloud lit from the camera's side the scattered light lives in a layer a
  * few mean free paths thick under the visible surface, thinner than a cell, and the grid cannot
- * resolve it (bench/RESULTS.md: the front-lit Disney cloud's multiple scattering reads 0.45–0.70 of
- * the path tracer's at 16–64 cells). What a pixel sees of the in-scattering is
+ * resolve it (the front-lit Disney cloud's multiple scattering reads well below the path tracer's
+ * at 16–64 cells: bench/RESULTS.md). What a pixel sees of the in-scattering is
  *   ∫ T(t) σs(t) J(t) dt = ∫ (σs/σt) J e^{−τ} dτ,     τ the optical depth from the camera,
  * so the nodes that matter are those spread evenly in e^{−τ} along the view rays: the layout of
  * production engines' froxels (frustum-aligned voxels; Hillaire 2015, "Physically based and unified
@@ -12,7 +12,7 @@
  *
  * Layout (node_grid_params ms_cache: nx·ny columns, nz = slices per column; node (cx, cy, s) at index
  * cx + nx·(cy + ny·s), MS_CACHE_STRIDE floats each): column (cx, cy) is the camera ray through the
- * image point ((cx + ½)·tile, (cy + ½)·tile), tile = realtime_params.ms_cache_tile pixels. Along it
+ * image point ((cx + ½)·tile, (cy + ½)·tile), tile = ms_cache_params.tile pixels. Along it
  * (once per cache, before any paths: ms_view_place_column), τ(t) is marched with
  * MS_VIEW_PLACE_STEPS samples over its occupied majorant cells (march.h), in the grey extinction σ̄t
  * (the mean of the three channels, per unit density), to its total τ_end (march_column_density;
@@ -28,7 +28,7 @@
  * estimates J̄_s = ∫_s J e^{−τ} dτ / ∫_s e^{−τ} dτ, and Σ_s (T_s − T_{s+1})·J̄_s is the column's own
  * in-scattering ∫ J e^{−τ} dτ exactly (for the grey σs/σt of a medium of one albedo). Point nodes
  * interpolated linearly in τ were biased where J falls steeply under the surface (convex in τ): the
- * back-lit Disney cloud's darker half read 1.1–2.8x the path tracer's at 8 slices (bench/RESULTS.md).
+ * back-lit Disney cloud's darker half read brighter than the path tracer's at 8 slices (bench/RESULTS.md).
  *
  * Lookup: a pixel's sample at grey optical depth τ (its own march's, ms_view_columns) reads its
  * four nearest columns, bilinear in image space; each column's slices are integrated over the
@@ -108,12 +108,12 @@ static inline void ms_view_store_level(NV_GLOBAL float* cache, size_t slice_stri
  * paths): marches the column for τ_end, then once more to every level, and writes each node's ends
  * (MS_VIEW_TAU …), which the build then reads instead of marching the column at every launch.
  * `cache` points at the column's first node (slice 0); slice s is nx·ny nodes further. */
-static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int column,
+static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int column,
                                         NV_GLOBAL float* cache) {
   NV_CONSTANT const scene_params* s = ctx->scene;
-  NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
+  NV_PRIVATE const node_grid_params* c = &mc->grid;
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
-  const ray3 r = ms_view_column_ray(&s->camera, rp->ms_cache_tile, column % c->nx, column / c->nx);
+  const ray3 r = ms_view_column_ray(&s->camera, mc->tile, column % c->nx, column / c->nx);
   for (int slice = 0; slice < c->nz; ++slice) {
     NV_GLOBAL float* v = cache + (size_t)slice * slice_stride;
     v[MS_VIEW_TAU] = v[MS_VIEW_TAU_END] = -1.0f;
@@ -151,11 +151,11 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const 
  * ∝ e^{−τ} on [τ_s, τ_{s+1}] from u (T = T_s − u·(T_s − T_{s+1})), and the point where the column
  * reaches it, marched across the slice in MS_VIEW_SAMPLE_STEPS steps (the slice's end when rounding
  * leaves it short). The node must hold medium (v[MS_VIEW_TAU] ≥ 0). */
-static inline vec3 ms_view_sample_point(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp, int node,
+static inline vec3 ms_view_sample_point(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int node,
                                         NV_GLOBAL const float* v, float u) {
   NV_CONSTANT const scene_params* s = ctx->scene;
-  NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
-  const ray3 r = ms_view_column_ray(&s->camera, rp->ms_cache_tile, node % c->nx, (node / c->nx) % c->ny);
+  NV_PRIVATE const node_grid_params* c = &mc->grid;
+  const ray3 r = ms_view_column_ray(&s->camera, mc->tile, node % c->nx, (node / c->nx) % c->ny);
   medium_segment seg;
   vec3 Lb;
   if (!march_view(s, ctx->lights, r.origin, r.dir, &Lb, &seg)) return vec3_madd(r.origin, r.dir, v[MS_VIEW_T]);
@@ -196,9 +196,9 @@ static inline int ms_view_axis(float u, int n, NV_PRIVATE float* w) {
   return node_grid_axis(u, n, w);
 }
 
-static inline ms_view_columns ms_view_locate(NV_CONSTANT const realtime_params* rp, int px, int py) {
-  NV_CONSTANT const node_grid_params* c = &rp->ms_cache;
-  const float tile = (float)rp->ms_cache_tile;
+static inline ms_view_columns ms_view_locate(NV_PRIVATE const ms_cache_params* mc, int px, int py) {
+  NV_PRIVATE const node_grid_params* c = &mc->grid;
+  const float tile = (float)mc->tile;
   float ax, ay;
   const int x0 = ms_view_axis(((float)px + 0.5f) / tile - 0.5f, c->nx, &ax);
   const int y0 = ms_view_axis(((float)py + 0.5f) / tile - 0.5f, c->ny, &ay);
@@ -220,13 +220,13 @@ static inline float ms_view_one_minus_exp(float x) { return x * march_step_weigh
  * medium. Each column's slices make J(τ) piecewise constant, so the step's mean under the weight
  * it gets in the step, e^{−(τ − tau)} (the energy-conserving step's, march.h), is exact:
  *   J_step = Σ_s J̄_s·(e^{−(lo_s − tau)} − e^{−(hi_s − tau)}) / (1 − e^{−dtau}),
- * [lo_s, hi_s] the part of slice s inside the step (the first slice reaching back to 0, the last
- * on to ∞). A point read at the step's middle was a quadrature of its own: 60 steps through the
- * back-lit Disney cloud cross several slices each near its surface (JND 8.7% against 8.0% at 120
- * steps). The weight is the grey τ's; a chromatic medium's channels fall at their own rates within
- * a step. A step inside one slice (most of them) and dtau = 0 read the slice holding tau, with no
- * exponential. */
-static inline vec3 ms_view_lookup(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* cache,
+ * [lo_s, hi_s] the part of slice s inside the step (the first slice reaching back to 0, the last on
+ * to ∞). A point read at the step's middle was a quadrature of its own: 60 steps through the
+ * back-lit Disney cloud cross several slices each near its surface, and the image then depended on
+ * the step count (bench/RESULTS.md). The weight is the grey τ's; a chromatic medium's channels fall
+ * at their own rates within a step. A step inside one slice (most of them) and dtau = 0 read the
+ * slice holding tau, with no exponential. */
+static inline vec3 ms_view_lookup(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache,
                                   NV_PRIVATE const ms_view_columns* cols, float tau, float dtau) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
   const float end = tau + dtau;

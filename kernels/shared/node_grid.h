@@ -13,10 +13,10 @@
 #include "shared/grid.h"
 #include "shared/structs.h"
 
-static inline int node_grid_count(NV_CONSTANT const node_grid_params* c) { return c->nx * c->ny * c->nz; }
+static inline int node_grid_count(NV_PRIVATE const node_grid_params* c) { return c->nx * c->ny * c->nz; }
 
 /* Index-space point of node `node` (x fastest) of the box [0, dims]. */
-static inline vec3 node_grid_point(NV_CONSTANT const node_grid_params* c, vec3 dims, int node) {
+static inline vec3 node_grid_point(NV_PRIVATE const node_grid_params* c, vec3 dims, int node) {
   const int i = node % c->nx, j = (node / c->nx) % c->ny, k = node / (c->nx * c->ny);
   return vec3_make(dims.x * ((float)i / (float)(c->nx - 1)), dims.y * ((float)j / (float)(c->ny - 1)),
                    dims.z * ((float)k / (float)(c->nz - 1)));
@@ -39,7 +39,7 @@ typedef struct node_grid_cell {
   float ax, ay, az;
 } node_grid_cell;
 
-static inline node_grid_cell node_grid_locate(NV_CONSTANT const node_grid_params* c, vec3 dims, vec3 p) {
+static inline node_grid_cell node_grid_locate(NV_PRIVATE const node_grid_params* c, vec3 dims, vec3 p) {
   node_grid_cell cell;
   const int x0 = node_grid_axis(p.x / dims.x * (float)(c->nx - 1), c->nx, &cell.ax);
   const int y0 = node_grid_axis(p.y / dims.y * (float)(c->ny - 1), c->ny, &cell.ay);
@@ -51,7 +51,7 @@ static inline node_grid_cell node_grid_locate(NV_CONSTANT const node_grid_params
 /* The cell's eight corners, k = dx + 2·dy + 4·dz: their offsets in a buffer of `stride` floats per
  * node and their trilinear weights (summing to 1). For a lookup that combines the corners other
  * than linearly (ms_cache.h). */
-static inline void node_grid_corners(NV_CONSTANT const node_grid_params* c, node_grid_cell cell, int stride,
+static inline void node_grid_corners(NV_PRIVATE const node_grid_params* c, node_grid_cell cell, int stride,
                                      NV_PRIVATE size_t* at, NV_PRIVATE float* w) {
   const size_t sy = (size_t)c->nx, sz = (size_t)c->nx * (size_t)c->ny;
   for (int k = 0; k < 8; ++k) {
@@ -63,7 +63,7 @@ static inline void node_grid_corners(NV_CONSTANT const node_grid_params* c, node
 
 /* Trilinear interpolation of the values v[stride·node] over the cell (grid_trilinear_combine, the
  * density lookups' arithmetic). */
-static inline float node_grid_interpolate(NV_CONSTANT const node_grid_params* c, NV_GLOBAL const float* v, int stride,
+static inline float node_grid_interpolate(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* v, int stride,
                                           node_grid_cell cell) {
   const size_t s1 = (size_t)stride, sy = (size_t)c->nx * s1, sz = (size_t)c->nx * (size_t)c->ny * s1;
   NV_GLOBAL const float* b = v + (size_t)cell.base * s1;

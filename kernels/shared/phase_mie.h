@@ -83,7 +83,7 @@ static inline float phase_mie_draine_above(float g, float alpha, float mu) {
  * HG's sampler does) by Newton's method kept inside a shrinking bracket [lo, hi], starting from
  * HG's inverse for the same g; a step that leaves the bracket bisects. The paper inverts the CDF
  * in closed form (a quartic); this root finder reaches the μ whose CDF is u to a few float steps
- * (24 iterations at most; about 5 on average), without the quartic's cancellation in float, and
+ * (24 iterations at most; far fewer on average: bench/RESULTS.md), without the quartic's cancellation in float, and
  * the pdf a caller uses is the phase function's value at the μ returned. */
 static inline float phase_mie_draine_sample(float g, float alpha, float u) {
   const float target = 1.0f - u;

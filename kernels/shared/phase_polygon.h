@@ -20,11 +20,10 @@
  *
  * Each edge is an arc of a great circle, walked along its chord (phase_polygon_edge), where the
  * integrand has no trigonometry and stays bounded at the pole (G/sin²θ → p(1)/2), with as many
- * 4-point Gauss panels as the arc holds phase widths: within 0.15% of the area integral for
- * Listing 4.1's light (86° × 64°) at g up to 0.9 and within 0.01% for a 6-unit light 20 units
- * away (the worst of 200 random points and axes each, against an 800×800 midpoint sum; the
- * configurations of tests/unit/phase_polygon_test.cpp within its 0.3%). With the
- * polygon traversed counter-clockwise about its inside, φ grows along an edge whose great circle
+ * 4-point Gauss panels as the arc holds phase widths: close to the area integral for Listing 4.1's
+ * light (86° × 64°) at g up to 0.9 and for a 6-unit light 20 units away (bench/RESULTS.md; the
+ * configurations of tests/unit/phase_polygon_test.cpp within its 0.3%). With the polygon
+ * traversed counter-clockwise about its inside, φ grows along an edge whose great circle
  * has a on its inner side. The contour counts ∫ G dφ from θ = 0 outwards: the polygon's integral
  * when it holds a or neither pole. */
 #ifndef NARVAL_PHASE_POLYGON_H

@@ -4,7 +4,7 @@
  * "Physically based sky, atmosphere and cloud rendering in Frostbite"). Deterministic: one ray
  * through the pixel centre, fixed quadrature, no random numbers.
  *
- * Parameters (realtime_params):
+ * Parameters (march_params, structs.h):
  * | field        | meaning                                                                  |
  * |--------------|--------------------------------------------------------------------------|
  * | steps        | samples over the occupied part of the view ray's box segment, true length  |
@@ -43,7 +43,7 @@
  * Shadow rays: light_cache_optical_depth (light_cache.h): one lookup in the light-transmittance
  * cache when it is on, else a march of shadow_steps samples.
  *
- * Multiple-scattering cache (ms_cache.h; rp->ms_cache.nx > 0): S_k gains σs(x_k) ⊙ (R + g·b·w_out),
+ * Multiple-scattering cache (ms_cache.h; ms_cache_params.grid.nx > 0): S_k gains σs(x_k) ⊙ (R + g·b·w_out),
  * the in-scattering towards the camera of the radiance arriving at x_k that the light sum above
  * does not hold (scattered at least once, and the background), by its directional average R and
  * first moment b, inside the same energy-conserving step.
@@ -83,8 +83,9 @@
 
 /* Light arriving at x and scattered towards the camera, per unit σs: Σ_lights (I/d²) ⊙
  * Σ_{i<N} aⁱ p(g cⁱ, μ) exp(−bⁱ τ). view_dir points away from the camera. */
-static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp,
-                                      NV_GLOBAL const float* light_cache, vec3 x, vec3 view_dir) {
+static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
+                                      NV_PRIVATE const node_grid_params* lc, NV_GLOBAL const float* light_cache, vec3 x,
+                                      vec3 view_dir) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
   NV_CONSTANT const medium_params* m = &s->medium;
@@ -93,16 +94,16 @@ static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
     light_point_view v;
     if (!light_view_from(&lights[l], x, &v)) continue;
     const vec3 dir = v.dir;
-    const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, rp, light_cache, l, x, dir, v.dist, view_dir);
-    if (rp->area_light_samples > 1 || rp->area_light_phase != AREA_LIGHT_POINTS) {
+    const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, mp, lc, light_cache, l, x, dir, v.dist, view_dir);
+    if (mp->area_light_samples > 1 || mp->area_light_phase != AREA_LIGHT_POINTS) {
       /* Rectangles as K×K points or integrated exactly (march_light_phase), one shadow for all. */
-      const int K = rp->area_light_samples, mode = rp->area_light_phase;
+      const int K = mp->area_light_samples, mode = mp->area_light_phase;
       vec3 lit = vec3_mul(vec3_exp_neg(tau), march_light_phase(&lights[l], x, m->phase, view_dir, mode, K));
       float ai = 1.0f, bi = 1.0f, ci = 1.0f;
-      for (int i = 1; i < rp->octaves; ++i) {
-        ai *= rp->octave_a;
-        bi *= rp->octave_b;
-        ci *= rp->octave_c;
+      for (int i = 1; i < mp->octaves; ++i) {
+        ai *= mp->octave_a;
+        bi *= mp->octave_b;
+        ci *= mp->octave_c;
         lit = vec3_add(lit, vec3_scale(vec3_mul(vec3_exp_neg(vec3_scale(tau, bi)),
                                                 march_light_phase(&lights[l], x, phase_scaled(m->phase, ci), view_dir, mode, K)),
                                        ai));
@@ -113,12 +114,12 @@ static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_CONSTANT const re
     /* K = 1: the centre alone, the dissertation's point light, with its arithmetic. */
     /* Octave 0: plain single scattering. */
     vec3 oct = vec3_scale(vec3_exp_neg(tau), phase_eval(m->phase, view_dir, dir));
-    if (rp->octaves > 1) {
+    if (mp->octaves > 1) {
       float ai = 1.0f, bi = 1.0f, ci = 1.0f;
-      for (int i = 1; i < rp->octaves; ++i) {
-        ai *= rp->octave_a;
-        bi *= rp->octave_b;
-        ci *= rp->octave_c;
+      for (int i = 1; i < mp->octaves; ++i) {
+        ai *= mp->octave_a;
+        bi *= mp->octave_b;
+        ci *= mp->octave_c;
         const float p = phase_eval(phase_scaled(m->phase, ci), view_dir, dir);
         oct = vec3_add(oct, vec3_scale(vec3_exp_neg(vec3_scale(tau, bi)), ai * p));
       }
@@ -137,14 +138,14 @@ typedef struct raymarch_accum {
  * at index-space point p (its middle), from grey optical depth tau to tau + dtau along the view ray:
  * the grid layout's at p (ms_cache.h), the view layout's over the step for the pixel whose columns
  * are `cols` (ms_cache_view.h). */
-static inline vec3 raymarch_ms_cache(NV_CONSTANT const realtime_params* rp, NV_CONSTANT const medium_params* m,
+static inline vec3 raymarch_ms_cache(NV_PRIVATE const ms_cache_params* mc, NV_CONSTANT const medium_params* m,
                                      NV_GLOBAL const float* ms_cache, NV_PRIVATE const ms_view_columns* cols, vec3 p,
                                      float tau, float dtau, vec3 dir) {
-  switch (rp->ms_cache_layout) {
+  switch (mc->layout) {
     case MS_CACHE_LAYOUT_GRID:
-      return ms_cache_lookup(&rp->ms_cache, ms_cache, vec3_from4(m->dims), p, phase_mean_cosine(m->phase),
-                             rp->ms_cache_closure, rp->ms_cache_interpolation, vec3_scale(dir, -1.0f));
-    case MS_CACHE_LAYOUT_VIEW: return ms_view_lookup(&rp->ms_cache, ms_cache, cols, tau, dtau);
+      return ms_cache_lookup(&mc->grid, ms_cache, vec3_from4(m->dims), p, phase_mean_cosine(m->phase), mc->closure,
+                             mc->interpolation, vec3_scale(dir, -1.0f));
+    case MS_CACHE_LAYOUT_VIEW: return ms_view_lookup(&mc->grid, ms_cache, cols, tau, dtau);
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
   }
 }
@@ -156,7 +157,8 @@ static inline vec3 raymarch_ms_cache(NV_CONSTANT const realtime_params* rp, NV_C
  * Loops: `steps` samples (march_next, its piece walk capped by the DDA budget), each
  * with num_lights shadow marches of shadow_steps samples and `octaves` (≤ 16) terms: all bounded by
  * the scene's own parameters, no cap of their own. */
-static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp,
+static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
+                                    NV_PRIVATE const node_grid_params* lc, NV_PRIVATE const ms_cache_params* mc,
                                     NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache,
                                     NV_PRIVATE const medium_segment* seg, NV_PRIVATE const ms_view_columns* cols,
                                     vec3 origin, vec3 dir, int steps, float t_stop, NV_PRIVATE raymarch_accum* acc) {
@@ -179,11 +181,11 @@ static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const real
     vec3 S = vec3_splat(0.0f);
     if (!vec3_is_zero(sigma_s)) {
       /* The lights' unscattered light, unless the cache holds it too (ms_cache.h, "Direct"). */
-      vec3 Li = rp->ms_cache.nx > 0 && rp->ms_cache_direct
+      vec3 Li = mc->grid.nx > 0 && mc->direct
                     ? vec3_splat(0.0f)
-                    : raymarch_light_sum(KERNEL_CONTEXT_ARG, rp, light_cache, vec3_madd(origin, dir, t), dir);
-      if (rp->ms_cache.nx > 0) /* the rest of the radiance arriving there (ms_cache.h), over the step */
-        Li = vec3_add(Li, raymarch_ms_cache(rp, m, ms_cache, cols, vec3_madd(seg->o, seg->d, t), tau, dtau, dir));
+                    : raymarch_light_sum(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(origin, dir, t), dir);
+      if (mc->grid.nx > 0) /* the rest of the radiance arriving there (ms_cache.h), over the step */
+        Li = vec3_add(Li, raymarch_ms_cache(mc, m, ms_cache, cols, vec3_madd(seg->o, seg->d, t), tau, dtau, dir));
       S = vec3_mul(sigma_s, Li);
     }
     tau += dtau;
@@ -197,7 +199,8 @@ static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_CONSTANT const real
 }
 
 /* Radiance through the centre of pixel (px, py). Pinhole: the ray leaves the lens centre. */
-static inline vec3 raymarch_pixel(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realtime_params* rp,
+static inline vec3 raymarch_pixel(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
+                                  NV_PRIVATE const node_grid_params* lc, NV_PRIVATE const ms_cache_params* mc,
                                   NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache, int px, int py) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
@@ -210,10 +213,10 @@ static inline vec3 raymarch_pixel(KERNEL_CONTEXT_PARAM, NV_CONSTANT const realti
     raymarch_accum acc;
     acc.L = vec3_splat(0.0f);
     acc.T = vec3_splat(1.0f);
-    const float t_stop = rp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb));
-    const ms_view_columns cols = ms_view_locate(rp, px, py);
-    raymarch_segment(KERNEL_CONTEXT_ARG, rp, light_cache, ms_cache, &seg, &cols, r.origin, r.dir, rp->steps, t_stop,
-                     &acc);
+    const float t_stop = mp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb));
+    const ms_view_columns cols = ms_view_locate(mc, px, py);
+    raymarch_segment(KERNEL_CONTEXT_ARG, mp, lc, mc, light_cache, ms_cache, &seg, &cols, r.origin, r.dir, mp->steps,
+                     t_stop, &acc);
     L = vec3_add(acc.L, vec3_mul(acc.T, Lb));
   } else {
     L = Lb;

@@ -29,39 +29,47 @@ static inline uint scene_kinds_status(NV_CONSTANT const scene_params* s, NV_CONS
   return status;
 }
 
-/* The real-time kernels' own kinds (realtime_params): STATUS_UNKNOWN_KIND for a value no switch
- * knows. The host never uploads one; a kernel built against other headers would. */
-static inline uint realtime_kinds_status(NV_CONSTANT const realtime_params* rp) {
+/* The real-time kernels' own kinds, per parameter block (structs.h): STATUS_UNKNOWN_KIND for a value
+ * no switch knows. The host never uploads one; a kernel built against other headers would. */
+static inline uint march_kinds_status(NV_PRIVATE const march_params* mp) {
   uint status = 0u;
-  switch (rp->area_light_phase) {
+  switch (mp->area_light_phase) {
     case AREA_LIGHT_POINTS:
     case AREA_LIGHT_EXACT: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
-  switch (rp->ms_cache_closure) {
+  switch (mp->shadow_weighting) {
+    case SHADOW_WEIGHTING_AREA:
+    case SHADOW_WEIGHTING_PHASE: break;
+    default: status |= STATUS_UNKNOWN_KIND;
+  }
+  return status;
+}
+
+static inline uint lobe_kinds_status(NV_PRIVATE const lobe_params* lp) {
+  switch (lp->variant) {
+    case LOBE_EQ7:
+    case LOBE_CORRECTED: return 0u;
+    default: return STATUS_UNKNOWN_KIND;
+  }
+}
+
+static inline uint ms_cache_kinds_status(NV_PRIVATE const ms_cache_params* mc) {
+  uint status = 0u;
+  switch (mc->closure) {
     case MS_CACHE_CLOSURE_LINEAR:
     case MS_CACHE_CLOSURE_HG:
     case MS_CACHE_CLOSURE_CAMERA: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
-  switch (rp->ms_cache_interpolation) {
+  switch (mc->interpolation) {
     case MS_CACHE_INTERPOLATION_GEOMETRIC:
     case MS_CACHE_INTERPOLATION_LINEAR: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
-  switch (rp->shadow_weighting) {
-    case SHADOW_WEIGHTING_AREA:
-    case SHADOW_WEIGHTING_PHASE: break;
-    default: status |= STATUS_UNKNOWN_KIND;
-  }
-  switch (rp->ms_cache_layout) {
+  switch (mc->layout) {
     case MS_CACHE_LAYOUT_GRID:
     case MS_CACHE_LAYOUT_VIEW: break;
-    default: status |= STATUS_UNKNOWN_KIND;
-  }
-  switch (rp->lobe_variant) {
-    case LOBE_EQ7:
-    case LOBE_CORRECTED: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
   return status;

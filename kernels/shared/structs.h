@@ -75,7 +75,7 @@ typedef struct majorant_grid_params {
 
 /* Emission of the medium (pbrt-v4's model: σa(x)·Le(x) per unit length). The emission grid has an
  * index space of its own (its own transform and bounding box in the file); index_to_grid maps the
- * medium's index space into it. B is the blackbody table (host/render/blackbody.h): table_size
+ * medium's index space into it. B is the blackbody table (host/colour/blackbody.h): table_size
  * linear-sRGB entries over [0, table_max] kelvin, evenly spaced, 0 at or below 100 K. */
 typedef struct emission_params {
   nv_affine index_to_grid; /* medium index space → emission grid index space */
@@ -131,7 +131,7 @@ typedef struct node_grid_params {
 #define LOBE_CORRECTED 1
 
 /* How the real-time kernels integrate the phase function over a rectangle light (march_light_phase):
- * K×K points (K = realtime_params.area_light_samples; 1, the centre, is the dissertation's), or the
+ * K×K points (K = march_params.area_light_samples; 1, the centre, is the dissertation's), or the
  * exact solid-angle integral (phase_polygon.h). */
 #define AREA_LIGHT_POINTS 0
 #define AREA_LIGHT_EXACT 1
@@ -157,39 +157,54 @@ typedef struct node_grid_params {
 #define MS_CACHE_LAYOUT_GRID 0
 #define MS_CACHE_LAYOUT_VIEW 1
 
-/* Parameters of the real-time kernels (raymarch.cl, lobe.cl); DESIGN.md "raymarch", "lobe". */
-typedef struct realtime_params {
-  int steps;            /* raymarch: samples over the view ray's segment; lobe: first-hit search samples */
-  int shadow_steps;     /* samples per shadow ray (and per light-cache node when the cache is built) */
-  int octaves;          /* raymarch multiple-scattering octaves (Wrenninge et al. 2013); 1 = off */
-  float octave_a;       /* scattering scale per octave */
-  float octave_b;       /* extinction scale per octave (a <= b conserves energy) */
-  float octave_c;       /* phase anisotropy scale per octave */
-  float depth_factor;   /* lobe: centre at depth_factor mean free paths past the first hit */
-  float lobe_radius;    /* lobe: eq7 world units; corrected mean free paths of unit density */
-  int lobe_points;      /* lobe: directions in the lobe_directions buffer */
-  int view_steps;       /* lobe: samples of each transmittance from the first hit to a lobe point */
-  float min_transmittance; /* view marches stop once every channel's transmittance is below it; 0: never */
-  int lobe_variant;     /* lobe: LOBE_EQ7 or LOBE_CORRECTED (lobe.h) */
-  node_grid_params light_cache; /* the light-transmittance cache (light_cache.h); nx = 0: off */
-  node_grid_params ms_cache;    /* raymarch: the multiple-scattering cache (ms_cache.h); nx = 0: off */
+/* The real-time kernels' parameters, one block per feature, each a kernel argument of its own
+ * (passed by value, bound by name: host/cl/kernel_args.cpp). DESIGN.md "raymarch", "lobe". */
+
+/* The marches of the ray marcher and the lobe (and the light cache's build, which marches the
+ * shadow rays they would): sample counts, early stop, how rectangle lights are integrated. */
+typedef struct march_params {
+  int steps;                /* raymarch: samples over the view ray's segment; lobe: first-hit search samples */
+  int shadow_steps;         /* samples per shadow ray (and per light-cache node when the cache is built) */
+  float min_transmittance;  /* view marches stop once every channel's transmittance is below it; 0: never */
   int area_light_samples;   /* K: a rectangle is K×K points for the phase and 1/d² (march_light_phase_sum) */
   int shadow_area_samples;  /* K: a rectangle's shadow averaged over K×K points (march_light_column) */
   int area_light_phase;     /* AREA_LIGHT_POINTS (area_light_samples) or AREA_LIGHT_EXACT (march_light_phase) */
-  int ms_cache_closure;     /* raymarch: MS_CACHE_CLOSURE_LINEAR, _HG or _CAMERA (ms_cache.h, "Closure") */
-  int ms_cache_interpolation; /* raymarch: MS_CACHE_INTERPOLATION_GEOMETRIC or _LINEAR ("Interpolation") */
-  int ms_cache_layout;      /* raymarch: MS_CACHE_LAYOUT_GRID or _VIEW (ms_cache_view.h) */
-  int ms_cache_tile;        /* MS_CACHE_LAYOUT_VIEW: pixels per column side (ms_cache.nx, ny columns) */
-  int shadow_weighting;     /* raymarch: SHADOW_WEIGHTING_AREA or _PHASE (march_light_column) */
-  int ms_cache_direct;      /* raymarch: 1: the cache holds the lights' unscattered light too (ms_cache.h, "Direct") */
-  float ms_cache_filter;    /* MS_CACHE_LAYOUT_VIEW: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
-  float ms_cache_filter_tolerance; /* the filter's k: standard errors a neighbour may differ by (ms_cache_filter.h) */
-  float ms_cache_guide;     /* closure camera: share of a path's first direction drawn towards the lights (phase_guide.h) */
-  int ms_cache_filter_twicing; /* MS_CACHE_LAYOUT_VIEW, filter on: 1: the filter's residual filtered and added back (ms_cache_filter.h, "Twicing") */
+  int shadow_weighting;     /* SHADOW_WEIGHTING_AREA or _PHASE (march_light_column) */
+  int octaves;              /* raymarch: multiple-scattering octaves (Wrenninge et al. 2013); 1 = off */
+  float octave_a;           /* scattering scale per octave */
+  float octave_b;           /* extinction scale per octave (a <= b conserves energy) */
+  float octave_c;           /* phase anisotropy scale per octave */
+  int pad0;
+} march_params;
+
+/* The Lobe Estimator (lobe.h). */
+typedef struct lobe_params {
+  float depth_factor;  /* the centre at depth_factor mean free paths past the first hit */
+  float radius;        /* eq7: world units; corrected: mean free paths of unit density */
+  int points;          /* directions in the lobe_directions buffer */
+  int view_steps;      /* samples of each transmittance from the first hit to a lobe point */
+  int variant;         /* LOBE_EQ7 or LOBE_CORRECTED */
   int pad0;
   int pad1;
   int pad2;
-} realtime_params;
+} lobe_params;
+
+/* The ray marcher's multiple-scattering cache (ms_cache.h; ms_cache_view.h). */
+typedef struct ms_cache_params {
+  node_grid_params grid;  /* the nodes (the view layout: columns nx × ny of slices nz); nx = 0: off */
+  int closure;            /* MS_CACHE_CLOSURE_LINEAR, _HG or _CAMERA (ms_cache.h, "Closure") */
+  int interpolation;      /* MS_CACHE_INTERPOLATION_GEOMETRIC or _LINEAR ("Interpolation") */
+  int layout;             /* MS_CACHE_LAYOUT_GRID or _VIEW (ms_cache_view.h) */
+  int tile;               /* the view layout: pixels per column side */
+  int direct;             /* 1: the cache holds the lights' unscattered light too (ms_cache.h, "Direct") */
+  int filter_twicing;     /* the view layout, filter on: 1: the residual filtered and added back ("Twicing") */
+  float filter;           /* the view layout: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
+  float filter_tolerance; /* the filter's k: standard errors a neighbour may differ by */
+  float guide;            /* closure camera: share of a path's first direction drawn towards the lights (phase_guide.h) */
+  int pad0;
+  int pad1;
+  int pad2;
+} ms_cache_params;
 
 typedef struct scene_params {
   camera_params camera;

@@ -14,7 +14,7 @@
 
 #include "shared/emission.h"
 #include "shared/kernel_context.h"
-#include "shared/majorant.h"
+#include "shared/majorant_dda.h"
 #include "shared/rng.h"
 #include "shared/sampling.h"
 #include "shared/structs.h"
@@ -28,8 +28,8 @@
  * also where float arithmetic gives out: the mean step 1/σ̄ ≈ 1e-7·ℓ is then about an ulp of t
  * wherever t is of the order of ℓ or more (2⁻²³·t ≈ 1.2e-7·t), so t no longer follows the
  * exponential steps it samples and, a little denser, t + step rounds back to t: the walk stands
- * still. Hitting the cap costs one work-item 1.4 s on this machine's PoCL CPU (printed by
- * StatusWord.OverDenseGridHitsTheTrackingCapWithoutHelp).
+ * still. Hitting the cap is slow but bounded (StatusWord.OverDenseGridHitsTheTrackingCapWithoutHelp
+ * prints its cost; bench/RESULTS.md).
  * NARVAL_TRACKING_MAX_STEPS overrides it at build time (tests force the cap with a small value). */
 #ifndef NARVAL_TRACKING_MAX_STEPS
 #define NARVAL_TRACKING_MAX_STEPS 10000000

@@ -8,10 +8,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "image/image.h"
 #include "cli/cli_fixture.h"
+#include "image/image.h"
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace fs = std::filesystem;
 

@@ -14,8 +14,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "image/image.h"
 #include "cli/cli_fixture.h"
+#include "image/image.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -218,7 +218,7 @@ TEST_F(CompareCli, BadOptions) {
   EXPECT_EQ(run("compare a.exr a.exr --tonemap ACES").code, 0);
 }
 
-// --reference-snapshot (render/reference_noise.h): a reference of 8192 samples, grey 0.125, and its
+// --reference-snapshot (host/analysis/reference_noise.h): a reference of 8192 samples, grey 0.125, and its
 // snapshot after the first 2048, where 12 pixels read 0.125 + √3·0.091. The reference's own error is
 // then estimated as (1/√3)·(S − R) (k = √(2048/6144)), which puts those 12 pixels at 0.216: ΔE76
 // 116·(∛0.216 − ∛0.125) = 116·(0.6 − 0.5) = 11.6 each (L* of a grey Y > 0.008856 is 116·∛Y − 16),

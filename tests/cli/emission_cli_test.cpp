@@ -7,7 +7,8 @@
 #include <string>
 
 #include "cli/cli_fixture.h"
-#include "volume/grid.h"
+#include "vdb_test_file.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 namespace {

@@ -1,6 +1,6 @@
 // `narval info FILE [--json]`: the grids of a .vdb or .vol file as a user frames a camera or picks a
 // temperature scale with them. Values derived from how the test files are written
-// (host/volume/grid.h, writeVdbTestFile "emission"):
+// (tests/vdb_test_file.h, writeVdbTestFile "emission"):
 // - "smoke": voxels (0..7)³ = 0.5, voxel size 1, identity transform: index box [0, 7]³, world box
 //   [-0.5, 7.5]³ (voxel i covers [i - ½, i + ½]), 8³ = 512 active voxels, 2048 bytes dense;
 // - "heat": voxels -1..20 on each axis at voxel size 0.5, translated by (-1, -1, -1): world box
@@ -19,7 +19,8 @@
 #include <filesystem>
 
 #include "cli/cli_fixture.h"
-#include "volume/grid.h"
+#include "vdb_test_file.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 namespace {

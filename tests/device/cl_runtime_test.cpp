@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cl/cl_runtime.h"
-#include "scene/input_error.h"
+#include "core/input_error.h"
 #include "test_support.h"
 
 namespace narval {

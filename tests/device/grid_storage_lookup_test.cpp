@@ -39,9 +39,9 @@
 #include "render/kernel_features.h"
 #include "shared/grid.h"
 #include "shared/structs.h"
-#include "volume/brick_grid.h"
-#include "volume/grid.h"
 #include "test_support.h"
+#include "volume/brick_grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 const std::map<std::string, std::string>& testKernelSources();

@@ -63,7 +63,7 @@ TEST(KernelArgs, AnUnknownNameIsAnErrorNamingTheArguments) {
   } catch (const std::logic_error& e) {
     EXPECT_STREQ(e.what(),
                  "kernel 'light_cache_build' has no argument 'status' (its arguments: scene, lights, grid, "
-                 "grid_majorants, emission_grid, emission_table, params, light, cache, status_word)");
+                 "grid_majorants, emission_grid, emission_table, march, light_cache, light, cache, status_word)");
   }
   EXPECT_THROW(kernelArgumentNames("volume_march"), std::logic_error);
 }

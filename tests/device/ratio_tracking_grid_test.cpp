@@ -24,9 +24,9 @@
 #include "scene/scene.h"
 #include "shared/grid.h"
 #include "shared/medium.h"
-#include "volume/brick_grid.h"
-#include "volume/grid.h"
 #include "unit/host_context.h"
+#include "volume/brick_grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 const std::map<std::string, std::string>& testKernelSources();

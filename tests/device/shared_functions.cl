@@ -151,14 +151,21 @@ __kernel void sf_scene_kinds(__constant scene_params* s, __constant light_params
   out[3] = (uint)light_sample_point(&lights[0], vec3_make(0.0f, 0.0f, 0.0f), 0.5f, 0.5f, &ls);
 }
 
-/* The real-time kernels' kinds, one item: out[0] the entry's status (realtime_kinds_status), out[1]
- * the bits of march_light_phase's red for lights[0] seen from the origin along +z (HG 0.5, K = 1),
- * out[2] the bits of ms_cache_closure for R = 2, g = 0.8, b/R = (0, 0, 0.9) towards +z. */
-__kernel void sf_realtime_kinds(__constant realtime_params* rp, __constant light_params* lights, __global uint* out,
+/* The real-time kernels' kinds, one item: out[0] the entries' status (march_, lobe_ and
+ * ms_cache_kinds_status), out[1] the bits of march_light_phase's red for lights[0] seen from the
+ * origin along +z (HG 0.5, K = 1), out[2] the bits of ms_cache_closure for R = 2, g = 0.8,
+ * b/R = (0, 0, 0.9) towards +z. The blocks, kernel arguments by value in the renderer, are copied to
+ * private memory as those are. */
+__kernel void sf_realtime_kinds(__constant march_params* mp, __constant lobe_params* lp,
+                                __constant ms_cache_params* mcp, __constant light_params* lights, __global uint* out,
                                 uint n) {
   if (get_global_id(0) != 0 || n < 1u) return;
+  const march_params march = *mp;
+  const lobe_params lobe = *lp;
+  const ms_cache_params ms_cache = *mcp;
   const vec3 w = vec3_make(0.0f, 0.0f, 1.0f);
-  out[0] = realtime_kinds_status(rp);
-  out[1] = as_uint(march_light_phase(&lights[0], vec3_make(0.0f, 0.0f, 0.0f), phase_make(PHASE_HG, 0.5f), w, rp->area_light_phase, 1).x);
-  out[2] = as_uint(ms_cache_closure(rp->ms_cache_closure, 2.0f, 0.8f, vec3_make(0.0f, 0.0f, 0.9f), w));
+  out[0] = march_kinds_status(&march) | lobe_kinds_status(&lobe) | ms_cache_kinds_status(&ms_cache);
+  out[1] = as_uint(march_light_phase(&lights[0], vec3_make(0.0f, 0.0f, 0.0f), phase_make(PHASE_HG, 0.5f), w,
+                                     march.area_light_phase, 1).x);
+  out[2] = as_uint(ms_cache_closure(ms_cache.closure, 2.0f, 0.8f, vec3_make(0.0f, 0.0f, 0.9f), w));
 }

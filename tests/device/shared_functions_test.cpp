@@ -531,12 +531,14 @@ TEST_F(SharedOnDevice, UnknownKindsSetTheStatusBitAndSendNothing) {
   EXPECT_EQ(probe()[0], 0u);
 }
 
-// The real-time kinds (realtime_params): the area-light phase, the cache's closure and the lobe
+// The real-time kinds (march_params, lobe_params, ms_cache_params): the area-light phase, the cache's closure and the lobe
 // variant. Known values: status 0, and the device computes what the host does (a 2x2 rectangle 2
 // units along +z, seen along +z, at its centre and exactly; the HG closure's 4πR·p_HG(gμ) with
 // μ = 0.3). An unknown one sets STATUS_UNKNOWN_KIND and its switch gives nothing.
 TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
-  realtime_params rp{};
+  march_params mp{};
+  lobe_params lp{};
+  ms_cache_params mc{};
   std::vector<light_params> lights(1);
   lights[0].type = LIGHT_RECTANGLE;
   lights[0].corner = nv_float4{-1, -1, 2, 0};
@@ -544,7 +546,7 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
   lights[0].edge_v = nv_float4{0, 2, 0, 0};
   lights[0].normal = nv_float4{0, 0, -1, 4};  // emits towards −z, at the origin; w = its area
   lights[0].radiance = nv_float4{3, 3, 3, 0};
-  auto probe = [&]() { return run<cl_uint>("sf_realtime_kinds", 1, 3, 2, constant(rp), input(lights)); };
+  auto probe = [&]() { return run<cl_uint>("sf_realtime_kinds", 1, 3, 4, constant(mp), constant(lp), constant(mc), input(lights)); };
   auto value = [](cl_uint u) {
     float f;
     std::memcpy(&f, &u, sizeof f);
@@ -553,8 +555,8 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
   const vec3 w = vec3_make(0, 0, 1);
   for (int phase : {AREA_LIGHT_POINTS, AREA_LIGHT_EXACT})
     for (int closure : {MS_CACHE_CLOSURE_LINEAR, MS_CACHE_CLOSURE_HG, MS_CACHE_CLOSURE_CAMERA}) {
-      rp.area_light_phase = phase;
-      rp.ms_cache_closure = closure;
+      mp.area_light_phase = phase;
+      mc.closure = closure;
       const std::vector<cl_uint> out = probe();
       EXPECT_EQ(out[0], 0u);
       const float host = march_light_phase(&lights[0], vec3_make(0, 0, 0), phase_make(PHASE_HG, 0.5f), w, phase, 1).x;
@@ -567,31 +569,31 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
   EXPECT_EQ(ms_cache_closure(MS_CACHE_CLOSURE_CAMERA, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w), 2.0f);
   // HG closure, forwards: 4πR·p_HG(k, 1) = R(1 + k)/(1 − k)², k = 0.8·0.3 = 0.24: 2·1.24/0.5776.
   EXPECT_NEAR(ms_cache_closure(MS_CACHE_CLOSURE_HG, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w), 2 * 1.24 / 0.5776, 1e-5);
-  rp.area_light_phase = 3;
+  mp.area_light_phase = 3;
   std::vector<cl_uint> out = probe();
   EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
   EXPECT_EQ(value(out[1]), 0.0f);
-  rp.area_light_phase = AREA_LIGHT_EXACT;
-  rp.ms_cache_closure = 4;
+  mp.area_light_phase = AREA_LIGHT_EXACT;
+  mc.closure = 4;
   out = probe();
   EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
   EXPECT_EQ(value(out[2]), 0.0f);
-  rp.ms_cache_closure = MS_CACHE_CLOSURE_HG;
-  rp.lobe_variant = 2;
+  mc.closure = MS_CACHE_CLOSURE_HG;
+  lp.variant = 2;
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
-  rp.lobe_variant = LOBE_CORRECTED;
+  lp.variant = LOBE_CORRECTED;
   EXPECT_EQ(probe()[0], 0u);
-  rp.ms_cache_interpolation = 2;
+  mc.interpolation = 2;
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
-  rp.ms_cache_interpolation = MS_CACHE_INTERPOLATION_LINEAR;
-  rp.ms_cache_layout = MS_CACHE_LAYOUT_VIEW;
+  mc.interpolation = MS_CACHE_INTERPOLATION_LINEAR;
+  mc.layout = MS_CACHE_LAYOUT_VIEW;
   EXPECT_EQ(probe()[0], 0u);
-  rp.ms_cache_layout = 2;
+  mc.layout = 2;
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
-  rp.ms_cache_layout = MS_CACHE_LAYOUT_GRID;
-  rp.shadow_weighting = SHADOW_WEIGHTING_PHASE;
+  mc.layout = MS_CACHE_LAYOUT_GRID;
+  mp.shadow_weighting = SHADOW_WEIGHTING_PHASE;
   EXPECT_EQ(probe()[0], 0u);
-  rp.shadow_weighting = 2;
+  mp.shadow_weighting = 2;
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
 }
 

@@ -40,20 +40,18 @@
   F(scene_params, has_medium) F(scene_params, num_lights) F(scene_params, max_bounces)             \
   F(scene_params, seed) F(scene_params, light_sampling) F(scene_params, shadow_roulette)           \
   F(scene_params, pad0) F(scene_params, pad1)                                                     \
-  S(realtime_params) F(realtime_params, steps) F(realtime_params, shadow_steps)                   \
-  F(realtime_params, octaves) F(realtime_params, octave_a) F(realtime_params, octave_b)           \
-  F(realtime_params, octave_c) F(realtime_params, depth_factor) F(realtime_params, lobe_radius)   \
-  F(realtime_params, lobe_points) F(realtime_params, view_steps)                                  \
-  F(realtime_params, min_transmittance) F(realtime_params, lobe_variant) F(realtime_params, light_cache)\
-  F(realtime_params, light_cache.nz) F(realtime_params, ms_cache) F(realtime_params, ms_cache.nz)  \
-  F(realtime_params, area_light_samples) F(realtime_params, shadow_area_samples)         \
-  F(realtime_params, area_light_phase) F(realtime_params, ms_cache_closure)  \
-  F(realtime_params, ms_cache_interpolation) F(realtime_params, ms_cache_layout)                \
-  F(realtime_params, ms_cache_tile) F(realtime_params, shadow_weighting) \
-  F(realtime_params, ms_cache_direct) F(realtime_params, ms_cache_filter)                     \
-  F(realtime_params, ms_cache_filter_tolerance) F(realtime_params, ms_cache_guide)                          \
-  F(realtime_params, ms_cache_filter_twicing) F(realtime_params, pad0) F(realtime_params, pad1)            \
-  F(realtime_params, pad2)                                                                                 \
+  S(march_params) F(march_params, steps) F(march_params, shadow_steps) F(march_params, min_transmittance) \
+  F(march_params, area_light_samples) F(march_params, shadow_area_samples) F(march_params, area_light_phase) \
+  F(march_params, shadow_weighting) F(march_params, octaves) F(march_params, octave_a)                   \
+  F(march_params, octave_b) F(march_params, octave_c) F(march_params, pad0)                               \
+  S(lobe_params) F(lobe_params, depth_factor) F(lobe_params, radius) F(lobe_params, points)               \
+  F(lobe_params, view_steps) F(lobe_params, variant) F(lobe_params, pad0) F(lobe_params, pad1)            \
+  F(lobe_params, pad2)                                                                                    \
+  S(ms_cache_params) F(ms_cache_params, grid) F(ms_cache_params, grid.nz) F(ms_cache_params, closure)     \
+  F(ms_cache_params, interpolation) F(ms_cache_params, layout) F(ms_cache_params, tile)                   \
+  F(ms_cache_params, direct) F(ms_cache_params, filter_twicing) F(ms_cache_params, filter)                \
+  F(ms_cache_params, filter_tolerance) F(ms_cache_params, guide) F(ms_cache_params, pad0)                 \
+  F(ms_cache_params, pad1) F(ms_cache_params, pad2)                                                       \
   S(node_grid_params) F(node_grid_params, index_to_world) F(node_grid_params, nx)           \
   F(node_grid_params, ny) F(node_grid_params, nz) F(node_grid_params, pad0)
 

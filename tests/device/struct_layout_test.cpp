@@ -51,13 +51,16 @@ TEST(StructLayoutHost, SizesAreMultiplesOf16) {
     ++structs;
     EXPECT_EQ(v.value % 16u, 0u) << v.what << " = " << v.value;
   }
-  EXPECT_EQ(structs, 11);  // nv_float4, nv_affine, camera, light, medium, phase, emission, majorant grid, scene, node grid, realtime
+  EXPECT_EQ(structs, 13);  // nv_float4, nv_affine, camera, light, medium, phase, emission, majorant grid, scene,
+                           // march, lobe, ms cache, node grid
   EXPECT_EQ(sizeof(nv_float4), 16u);
   EXPECT_EQ(sizeof(nv_affine), 48u);
   EXPECT_EQ(sizeof(camera_params), 96u);
   EXPECT_EQ(sizeof(light_params), 96u);
   EXPECT_EQ(sizeof(node_grid_params), 64u);
-  EXPECT_EQ(sizeof(realtime_params), 240u);
+  EXPECT_EQ(sizeof(march_params), 48u);
+  EXPECT_EQ(sizeof(lobe_params), 32u);
+  EXPECT_EQ(sizeof(ms_cache_params), 112u);
   EXPECT_EQ(sizeof(majorant_grid_params), 32u);
   EXPECT_EQ(sizeof(emission_params), 112u);
   EXPECT_EQ(sizeof(phase_params), 32u);

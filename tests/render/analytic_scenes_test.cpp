@@ -7,7 +7,7 @@
 #include "render/scene_upload.h"
 #include "render_fixture.h"
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

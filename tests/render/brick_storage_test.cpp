@@ -12,15 +12,15 @@
 #include <sstream>
 #include <string>
 
-#include "render/device_allocation.h"
+#include "cl/device_allocation.h"
+#include "core/input_error.h"
 #include "render/device_grid.h"
-#include "render/kernel_features.h"
 #include "render/device_scene.h"
+#include "render/kernel_features.h"
 #include "render/render_common.h"
 #include "render_fixture.h"
-#include "scene/input_error.h"
 #include "volume/brick_grid.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

@@ -7,12 +7,12 @@
 
 #include <sstream>
 
-#include "render/device_allocation.h"
+#include "cl/device_allocation.h"
+#include "core/input_error.h"
 #include "render/device_grid.h"
 #include "render/pathtrace_renderer.h"
 #include "render/realtime_renderer.h"
 #include "render_fixture.h"
-#include "scene/input_error.h"
 
 namespace narval::test {
 namespace {

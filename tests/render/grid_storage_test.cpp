@@ -31,11 +31,11 @@
 #include <string>
 
 #include "render/device_grid.h"
-#include "render/kernel_features.h"
 #include "render/device_scene.h"
+#include "render/kernel_features.h"
 #include "render_fixture.h"
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

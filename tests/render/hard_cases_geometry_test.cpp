@@ -14,8 +14,8 @@
 #include "render/scene_upload.h"
 #include "render_fixture.h"
 #include "shared/grid.h"
-#include "volume/grid.h"
 #include "unit/host_context.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

@@ -11,10 +11,10 @@
 #include <cstdlib>
 #include <string>
 
+#include "core/input_error.h"
 #include "render/kernel_features.h"
 #include "render_fixture.h"
-#include "scene/input_error.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

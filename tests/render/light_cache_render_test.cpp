@@ -1,4 +1,4 @@
-// The real-time kernels' economies on the device: the light-transmittance cache (render/light_cache.h,
+// The real-time kernels' economies on the device: the light-transmittance cache (host/render/device_light_cache.h,
 // kernels/shared/light_cache.h), early termination of view marches, and the independence of their
 // pixels from the path tracer's --majorant-resolution. Each image error is bounded by a derivation
 // beside the test, per pixel; the cache's bookkeeping (what is rebuilt when) is counted.
@@ -8,13 +8,13 @@
 #include <cmath>
 #include <cstdio>
 
-#include "image/image_compare.h"
+#include "analysis/image_compare.h"
+#include "render/device_light_cache.h"
 #include "render/device_scene.h"
-#include "render/light_cache.h"
 #include "render/realtime_renderer.h"
 #include "render_fixture.h"
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {
@@ -88,7 +88,7 @@ TEST(LightCacheRender, ErrorAgainstExactMarchingFallsWithResolutionWithinTheDeri
     for (int cells : {4, 8, 16}) {
       const RenderResult cached = renderRt(litBoxJson(renderer(cells)));
       ASSERT_EQ(cached.stats.status, 0u);
-      EXPECT_EQ(cached.stats.lightCacheCells[0], cells);
+      EXPECT_EQ(cached.stats.lightCache.cells[0], cells);
       const double h = 1.0 / cells, bound = A * 2.0 * h * h / 8 * 0.4224 + 1e-6;
       int differing = 0;
       const double err = maxAbsDiff(exact.image, cached.image, &differing);
@@ -114,7 +114,7 @@ TEST(LightCacheRender, AutomaticCacheOnACloudStaysWithinOneDeltaEOfExactMarching
     const RenderResult exact = renderAlgorithm(sceneFromJson(litCloudJson(renderer("0"))), &cloud);
     const RenderResult cached = renderAlgorithm(sceneFromJson(litCloudJson(renderer("\"auto\""))), &cloud);
     ASSERT_EQ(cached.stats.status, 0u);
-    EXPECT_EQ(cached.stats.lightCacheBuilds, 2);  // one slab per light
+    EXPECT_EQ(cached.stats.lightCache.builds, 2);  // one slab per light
     const ImageComparison c = compareImages(exact.image, cached.image, DisplaySettings{});
     std::printf("[ light cache ] %s on a cloud, auto: mean dE76 %.4f, max %.3f\n", algorithm, c.stats76.mean,
                 c.stats76.max);
@@ -134,12 +134,12 @@ TEST(LightCacheRender, DeviceBuildMatchesTheHost) {
                                                        "lightCache": {"resolution": 20},
                                                        "raymarch": {"shadowWeighting": ")" + std::string(weighting) + R"("}})"));
     DeviceSceneBuffers dev(runtime(), scene, &cloud);
-    const realtime_params params = realtimeParams(scene, dev.scene);
-    EXPECT_EQ(params.shadow_weighting, std::string(weighting) == "phase" ? SHADOW_WEIGHTING_PHASE : SHADOW_WEIGHTING_AREA);
+    const RealtimeParams params = realtimeParams(scene, dev.scene);
+    EXPECT_EQ(params.march.shadow_weighting, std::string(weighting) == "phase" ? SHADOW_WEIGHTING_PHASE : SHADOW_WEIGHTING_AREA);
     DeviceLightCache cache;
-    cache.update(runtime(), dev, params, scene.sourcePath);
+    cache.update(runtime(), dev, params.march, params.lightCache, scene.sourcePath);
     const grid_view gv{cloud.data.data(), cloud.nx, cloud.ny, cloud.nz, dev.scene.majorants.data()};
-    const std::vector<float> host = buildLightCacheOnHost(dev.scene, &gv, params);
+    const std::vector<float> host = buildLightCacheOnHost(dev.scene, &gv, params.march, params.lightCache);
     std::vector<float> device(host.size());
     runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, device.size() * sizeof(float), device.data());
     int positive = 0;
@@ -162,11 +162,12 @@ TEST(LightCacheRender, ANanVoxelRaisesTheBuildsStatus) {
                                                      "lightCache": {"resolution": 8}})"));
   DeviceLightCache clean, poisoned;
   DeviceSceneBuffers devClean(runtime(), scene, &g);
-  clean.update(runtime(), devClean, realtimeParams(scene, devClean.scene), "clean");
+  const RealtimeParams params = realtimeParams(scene, devClean.scene);
+  clean.update(runtime(), devClean, params.march, params.lightCache, "clean");
   EXPECT_EQ(clean.status(), 0u);
   g.data[size_t(8 + 16 * (8 + 16 * 8))] = NAN;  // the centre voxel
   DeviceSceneBuffers devNan(runtime(), scene, &g);
-  poisoned.update(runtime(), devNan, realtimeParams(scene, devNan.scene), "nan");
+  poisoned.update(runtime(), devNan, params.march, params.lightCache, "nan");
   EXPECT_TRUE(poisoned.status() & STATUS_NAN);
   const RenderResult r = renderRealtime(runtime(), scene, &g, 1, RenderOptions{});
   EXPECT_TRUE(r.stats.status & STATUS_NAN);
@@ -187,45 +188,48 @@ TEST(LightCacheRender, RebuildsOnlyTheSlabsWhoseInputsChanged) {
   const std::string r = R"({"resolution": [8, 8], "algorithm": "raymarch", "storage": "buffer", "lightCache": {"resolution": 8}})";
   const Scene a = scene(r);
   DeviceLightCache cache;
+  auto update = [&](const DeviceSceneBuffers& dev, const RealtimeParams& p, const std::string& file) {
+    cache.update(runtime(), dev, p.march, p.lightCache, file);
+  };
   DeviceSceneBuffers devA(runtime(), a, &cloud);
-  const realtime_params pa = realtimeParams(a, devA.scene);
-  cache.update(runtime(), devA, pa, "a");
+  const RealtimeParams pa = realtimeParams(a, devA.scene);
+  cache.update(runtime(), devA, pa.march, pa.lightCache, "a");
   EXPECT_EQ(cache.slabsBuilt(), 2);
-  cache.update(runtime(), devA, pa, "a");
+  cache.update(runtime(), devA, pa.march, pa.lightCache, "a");
   EXPECT_EQ(cache.slabsBuilt(), 2);  // nothing changed: nothing built
 
   Scene camera = a;
   camera.camera.position = {1.0f, 0.5f, -6.0f};  // a camera move
   DeviceSceneBuffers devCamera(runtime(), camera, &cloud);
-  cache.update(runtime(), devCamera, realtimeParams(camera, devCamera.scene), "camera");
+  update(devCamera, realtimeParams(camera, devCamera.scene), "camera");
   EXPECT_EQ(cache.slabsBuilt(), 2);  // the cache does not depend on the camera
 
   Scene moved = a;
   moved.primitives[1].transform.position = {-1.5f, 2.5f, -1.0f};  // the point light
   DeviceSceneBuffers devMoved(runtime(), moved, &cloud);
-  cache.update(runtime(), devMoved, realtimeParams(moved, devMoved.scene), "moved");
+  update(devMoved, realtimeParams(moved, devMoved.scene), "moved");
   EXPECT_EQ(cache.slabsBuilt(), 3);  // that light's slab alone
 
   const Scene denser = scene(r, 5);
   DeviceSceneBuffers devDenser(runtime(), denser, &cloud);
-  cache.update(runtime(), devDenser, realtimeParams(denser, devDenser.scene), "denser");
+  update(devDenser, realtimeParams(denser, devDenser.scene), "denser");
   EXPECT_EQ(cache.slabsBuilt(), 5);  // the medium changed: every slab
 
-  realtime_params moreSteps = realtimeParams(denser, devDenser.scene);
-  moreSteps.shadow_steps += 1;
-  cache.update(runtime(), devDenser, moreSteps, "denser");
+  RealtimeParams moreSteps = realtimeParams(denser, devDenser.scene);
+  moreSteps.march.shadow_steps += 1;
+  update(devDenser, moreSteps, "denser");
   EXPECT_EQ(cache.slabsBuilt(), 7);
 
-  realtime_params phase = moreSteps;
-  phase.shadow_weighting = SHADOW_WEIGHTING_PHASE;
-  cache.update(runtime(), devDenser, phase, "denser");
+  RealtimeParams phase = moreSteps;
+  phase.march.shadow_weighting = SHADOW_WEIGHTING_PHASE;
+  update(devDenser, phase, "denser");
   EXPECT_EQ(cache.slabsBuilt(), 9);
-  cache.update(runtime(), devDenser, phase, "denser");
+  update(devDenser, phase, "denser");
   EXPECT_EQ(cache.slabsBuilt(), 9);
   Scene denserMoved = denser;
   denserMoved.camera.position = {1.0f, 0.5f, -6.0f};
   DeviceSceneBuffers devDenserMoved(runtime(), denserMoved, &cloud);
-  cache.update(runtime(), devDenserMoved, phase, "denser");
+  update(devDenserMoved, phase, "denser");
   EXPECT_EQ(cache.slabsBuilt(), 11);
 }
 

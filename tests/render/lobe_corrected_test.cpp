@@ -8,13 +8,13 @@
 #include <cstdio>
 #include <string>
 
-#include "image/image_compare.h"
+#include "analysis/image_compare.h"
 #include "render/realtime_renderer.h"
 #include "render/scene_upload.h"
 #include "render_fixture.h"
 #include "scene/scene.h"
 #include "shared/lobe.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

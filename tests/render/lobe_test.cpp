@@ -12,11 +12,11 @@
 #include "render/lobe_directions.h"
 #include "render/realtime_renderer.h"
 #include "render/scene_upload.h"
-#include "shared/phase.h"
 #include "render_fixture.h"
 #include "shared/lobe.h"
-#include "volume/grid.h"
+#include "shared/phase.h"
 #include "unit/host_context.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {
@@ -168,7 +168,7 @@ void expectEquation7(const Scene& sceneIn, const BoxFrame& box, int* hits) {
   const int n = scene.renderer.lobe.lobePoints;
   const std::vector<nv_float4> dirs = lobeDirections(n, phase_make(fog.phase, float(g)), scene.renderer.seed);
 
-  const realtime_params params = realtimeParams(scene, ds);
+  const RealtimeParams params = realtimeParams(scene, ds);
   const grid_view homogeneous{nullptr, 1, 1, 1};
   for (int py = 0; py < H; ++py)
     for (int px = 0; px < W; ++px) {
@@ -207,8 +207,8 @@ void expectEquation7(const Scene& sceneIn, const BoxFrame& box, int* hits) {
       // tested on the host): same float algorithm, so agreement to float rounding.
       uint status = 0;
       const vec3 host =
-          lobe_pixel(narval::test::sceneContext(&ds.params, ds.lights.data(), &homogeneous, &status), &params,
-                     dirs.data(), nullptr, px, py);
+          lobe_pixel(narval::test::sceneContext(&ds.params, ds.lights.data(), &homogeneous, &status), &params.march,
+                     &params.lobe, &params.lightCache, dirs.data(), nullptr, px, py);
       EXPECT_EQ(status, 0u);
       const float hostRgb[3] = {host.x, host.y, host.z};
       for (int ch = 0; ch < 3; ++ch) {

@@ -17,7 +17,7 @@
 #include "render/scene_upload.h"
 #include "render_fixture.h"
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 #include "volume/majorant_grid.h"
 
 namespace narval::test {
@@ -188,14 +188,14 @@ TEST(MajorantRender, EmptyCellsMakeNoLookups) {
     size_t wrong = 0;
     for (float v : r.image.rgb) wrong += v != 1.0f;
     EXPECT_EQ(wrong, 0u) << m;
-    EXPECT_TRUE(r.stats.counters);
-    EXPECT_EQ(r.stats.collisionsReal, 0u) << m;
+    EXPECT_TRUE(r.stats.counters.on);
+    EXPECT_EQ(r.stats.counters.real, 0u) << m;
     if (std::string(m) == "grid") {
-      EXPECT_EQ(r.stats.collisionsTentative, 0u);
-      EXPECT_EQ(r.stats.densityLookups, 0u);
+      EXPECT_EQ(r.stats.counters.tentative, 0u);
+      EXPECT_EQ(r.stats.counters.densityLookups, 0u);
     } else {
-      EXPECT_GT(r.stats.collisionsTentative, 1000u);  // σ̄·2 = 6 per path on average, 1024 paths
-      EXPECT_EQ(r.stats.densityLookups, r.stats.collisionsTentative);  // no lights: no shadow rays
+      EXPECT_GT(r.stats.counters.tentative, 1000u);  // σ̄·2 = 6 per path on average, 1024 paths
+      EXPECT_EQ(r.stats.counters.densityLookups, r.stats.counters.tentative);  // no lights: no shadow rays
     }
   }
 }
@@ -211,16 +211,16 @@ TEST(MajorantRender, CountersChangeNoPixelAndShowTheGridsSaving) {
     const RenderResult plain = renderMajorant(scene, &cloud, kModes[i]);
     const RenderResult counted = renderMajorant(scene, &cloud, kModes[i], true);
     EXPECT_EQ(plain.image.rgb, counted.image.rgb) << kModes[i];
-    EXPECT_FALSE(plain.stats.counters);
-    EXPECT_EQ(plain.stats.collisionsTentative + plain.stats.collisionsReal + plain.stats.densityLookups, 0u);
+    EXPECT_FALSE(plain.stats.counters.on);
+    EXPECT_EQ(plain.stats.counters.tentative + plain.stats.counters.real + plain.stats.counters.densityLookups, 0u);
     const RenderStats& s = counted.stats;
-    ASSERT_GT(s.collisionsReal, 0u);
-    EXPECT_GE(s.collisionsTentative, s.collisionsReal);
-    EXPECT_GT(s.densityLookups, s.collisionsTentative);  // shadow rays look up density too
-    perReal[i] = double(s.collisionsTentative) / double(s.collisionsReal);
+    ASSERT_GT(s.counters.real, 0u);
+    EXPECT_GE(s.counters.tentative, s.counters.real);
+    EXPECT_GT(s.counters.densityLookups, s.counters.tentative);  // shadow rays look up density too
+    perReal[i] = double(s.counters.tentative) / double(s.counters.real);
     std::printf("[ majorant ] %s: %llu tentative, %llu real (%.2f per real), %llu lookups\n", kModes[i],
-                (unsigned long long)s.collisionsTentative, (unsigned long long)s.collisionsReal, perReal[i],
-                (unsigned long long)s.densityLookups);
+                (unsigned long long)s.counters.tentative, (unsigned long long)s.counters.real, perReal[i],
+                (unsigned long long)s.counters.densityLookups);
   }
   EXPECT_LT(perReal[0], perReal[1]);
 }

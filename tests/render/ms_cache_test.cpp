@@ -1,4 +1,4 @@
-// The ray marcher's multiple-scattering cache (kernels/shared/ms_cache.h, render/ms_cache.h):
+// The ray marcher's multiple-scattering cache (kernels/shared/ms_cache.h, host/render/device_ms_cache.h):
 // the white furnace, where ray marching plus the cache is exact, and the cache's convergence and
 // determinism as it is refined.
 #include <gtest/gtest.h>
@@ -9,17 +9,17 @@
 #include <filesystem>
 #include <vector>
 
+#include "render/device_ms_cache.h"
 #include "render/device_scene.h"
-#include "render/ms_cache.h"
 #include "render/ms_cache_allocation.h"
-#include "render/node_grid.h"
+#include "render/node_grid_layout.h"
 #include "render/realtime_renderer.h"
+#include "render_fixture.h"
 #include "shared/ms_cache.h"
 #include "shared/ms_cache_filter.h"
 #include "shared/ms_cache_view.h"
-#include "render_fixture.h"
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {
@@ -75,15 +75,15 @@ TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
       const RenderResult cached =
           renderRealtime(runtime(), sceneFromJson(furnaceJson("cache", density, layout)), grid, 3, {});
       ASSERT_EQ(cached.stats.status, 0u);
-      EXPECT_EQ(cached.stats.msCachePaths, 8);
-      EXPECT_EQ(cached.stats.msCacheBuilds, 1);  // built once for three frames
-      EXPECT_EQ(cached.stats.msCacheCells[0], 4);
-      EXPECT_EQ(cached.stats.msCacheCells[2], cached.stats.msCacheView ? 8 : 4);
+      EXPECT_EQ(cached.stats.msCache.paths, 8);
+      EXPECT_EQ(cached.stats.msCache.builds, 1);  // built once for three frames
+      EXPECT_EQ(cached.stats.msCache.cells[0], 4);
+      EXPECT_EQ(cached.stats.msCache.cells[2], cached.stats.msCache.view ? 8 : 4);
       double worst = 0;
       for (float v : cached.image.rgb) worst = std::max(worst, std::fabs(v - 1.0));
       const bool filtered = layout.find("filter") != std::string::npos;
       std::printf("[ ms cache ] furnace (%s, %s): max |L - 1| %.2g with the cache\n", name,
-                  !cached.stats.msCacheView ? "grid" : filtered ? "view, filtered" : "view", worst);
+                  !cached.stats.msCache.view ? "grid" : filtered ? "view, filtered" : "view", worst);
       EXPECT_LE(worst, 1e-5);
     }
 
@@ -139,16 +139,16 @@ Scene litBox() {
 }
 
 // The cache's running means, after checking its status word.
-std::vector<float> runningMeans(const DeviceMsCache& cache, const realtime_params& params) {
+std::vector<float> runningMeans(const DeviceMsCache& cache, const ms_cache_params& params) {
   EXPECT_EQ(cache.status(), 0u);
-  std::vector<float> v(nodeGridCount(params.ms_cache) * MS_CACHE_STRIDE);
+  std::vector<float> v(nodeGridCount(params.grid) * MS_CACHE_STRIDE);
   runtime().queue.enqueueReadBuffer(cache.means(), CL_TRUE, 0, v.size() * sizeof(float), v.data());
   return v;
 }
 
 std::vector<float> cacheAfter(const Scene& scene, int paths, int perLaunch) {
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
-  const realtime_params params = realtimeParams(scene, dev.scene);
+  const ms_cache_params params = realtimeParams(scene, dev.scene).msCache;
   DeviceMsCache cache;
   cache.refine(runtime(), dev, params, paths, perLaunch, "lit_box.json");
   return runningMeans(cache, params);
@@ -184,7 +184,7 @@ TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
 // allocation is not the even share here).
 std::vector<float> allocatedCacheAfter(const Scene& scene, int mean, int perLaunch, bool progressive) {
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
-  const realtime_params params = realtimeParams(scene, dev.scene);
+  const ms_cache_params params = realtimeParams(scene, dev.scene).msCache;
   MsCacheAllocation allocation;
   allocation.perceptual = true;
   allocation.meanPaths = mean;
@@ -241,7 +241,7 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   scene.renderer.raymarch.msCache.filter = 1.5f;
   scene.renderer.raymarch.msCache.filterTolerance = 2.0f;
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
-  const realtime_params params = realtimeParams(scene, dev.scene);
+  const ms_cache_params params = realtimeParams(scene, dev.scene).msCache;
   DeviceMsCache cache;
   cache.refine(runtime(), dev, params, 48, 16, "lit_box.json");
   ASSERT_EQ(cache.status(), 0u);
@@ -249,7 +249,7 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   runtime().queue.enqueueReadBuffer(cache.means(), CL_TRUE, 0, means.size() * sizeof(float), means.data());
   runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, device.size() * sizeof(float), device.data());
   EXPECT_EQ(means, plain);
-  const node_grid_params& c = params.ms_cache;
+  const node_grid_params& c = params.grid;
   for (int column = 0; column < c.nx * c.ny; ++column)
     ms_view_filter_column(&c, means.data(), means.data(), 0, column, 1.5f, 2.0f,
                           host.data() + size_t(column) * MS_CACHE_STRIDE);
@@ -270,8 +270,8 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   // Twiced (ms_cache_filter.h, "Twicing"): the device's second pass is the shared code's over the
   // host's first pass, the weights again the means' (within 3e-5: two passes of exp rounding).
   scene.renderer.raymarch.msCache.filterTwicing = true;
-  const realtime_params twicing = realtimeParams(scene, dev.scene);
-  ASSERT_EQ(twicing.ms_cache_filter_twicing, 1);
+  const ms_cache_params twicing = realtimeParams(scene, dev.scene).msCache;
+  ASSERT_EQ(twicing.filter_twicing, 1);
   DeviceMsCache twicedCache;
   twicedCache.refine(runtime(), dev, twicing, 48, 16, "lit_box.json");
   ASSERT_EQ(twicedCache.status(), 0u);
@@ -301,7 +301,7 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
 void refineFromAnotherCamera(DeviceMsCache& cache, Scene scene, int paths) {
   scene.camera.position = {1, 1, -4};
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), paths, 8, "camera");
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, paths, 8, "camera");
 }
 
 // Kept across frames and camera moves, started over when the medium or a light changes: refine()
@@ -310,18 +310,18 @@ TEST(MsCache, StartsOverOnlyWhenWhatThePathsSeeChanges) {
   const Scene scene = litBox();
   DeviceMsCache cache;
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 8, 8, "a");
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 8, 8, "a");
   EXPECT_EQ(cache.rebuilds(), 1);
   EXPECT_EQ(cache.paths(), 8);
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 12, 8, "a");  // progressive: 4 more
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 12, 8, "a");  // progressive: 4 more
   EXPECT_EQ(cache.paths(), 12);
   refineFromAnotherCamera(cache, scene, 12);
   EXPECT_EQ(cache.rebuilds(), 1);
   Scene moved = scene;
   moved.primitives[0].transform.position = {0.5f, 0, 3};
   DeviceSceneBuffers devMoved(runtime(), moved, nullptr);
-  cache.refine(runtime(), devMoved, realtimeParams(moved, devMoved.scene), 12, 8, "moved");
+  cache.refine(runtime(), devMoved, realtimeParams(moved, devMoved.scene).msCache, 12, 8, "moved");
   EXPECT_EQ(cache.rebuilds(), 2);
   EXPECT_EQ(cache.paths(), 12);
 }
@@ -333,14 +333,14 @@ TEST(MsCache, TheCameraClosureStartsOverWhenTheCameraMoves) {
   Scene scene = litBox();
   DeviceMsCache cache;
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 8, 8, "a");
   scene.renderer.raymarch.msCache.closure = MsCacheClosure::Hg;
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 8, 8, "a");
   EXPECT_EQ(cache.rebuilds(), 1);
   scene.renderer.raymarch.msCache.closure = MsCacheClosure::Camera;
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 8, 8, "a");
   EXPECT_EQ(cache.rebuilds(), 2);
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene), 8, 8, "a");
+  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 8, 8, "a");
   EXPECT_EQ(cache.rebuilds(), 2);
   refineFromAnotherCamera(cache, scene, 8);
   EXPECT_EQ(cache.rebuilds(), 3);
@@ -477,7 +477,7 @@ LitBoxCheck checkLitBox(const std::string& phase, const std::string& coarseCache
   auto realtime = [&](const std::string& renderer, uint32_t seed) {
     const RenderResult r = renderRealtime(runtime(), scene(renderer, seed), grid, 1, RenderOptions{});
     EXPECT_EQ(r.stats.status, 0u);
-    if (out.budgetMax == 0) out.budgetMin = r.stats.msCacheBudgetMin, out.budgetMax = r.stats.msCacheBudgetMax;
+    if (out.budgetMax == 0) out.budgetMin = r.stats.msCache.budgetMin, out.budgetMax = r.stats.msCache.budgetMax;
     return r.image;
   };
   const ImageRGB coarseA = realtime(rm(64, "cache", coarseCache), 1), coarseB = realtime(rm(64, "cache", coarseCache), 2);
@@ -596,7 +596,7 @@ TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracer) {
 // The same in a heterogeneous medium: a 32³ grid filling the box whose density rises eightfold
 // along x and varies along y and z, (0.25 + 1.75·u)·(0.75 + 0.25·sin(2πv))·(1 + 0.5·w²), u, v, w the
 // voxel centre's coordinates in [0, 1]. There the cache's paths walk a majorant grid of their own,
-// the path tracer's resolution (32 cells on CPUs; the march keeps 16: render/ms_cache.cpp), and a
+// the path tracer's resolution (32 cells on CPUs; the march keeps 16: host/render/device_ms_cache.cpp), and a
 // grid bound to the wrong cells, or a bound below the density, would bias them against the path
 // tracer, which takes its own (measured: with the paths' majorants halved the worst |error|/bound
 // is 9.9, against 0.50 as built; the widest bound 16% of the value). No wisps: a field that fades

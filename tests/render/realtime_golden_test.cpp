@@ -19,7 +19,7 @@
 #include "image/image.h"
 #include "render_fixture.h"
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

@@ -25,7 +25,7 @@
 
 #include "render/realtime_renderer.h"
 #include "render_fixture.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

@@ -21,11 +21,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include "analysis/image_compare.h"
 #include "image/image.h"
-#include "image/image_compare.h"
 #include "render_fixture.h"
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

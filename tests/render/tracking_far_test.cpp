@@ -7,7 +7,7 @@
 #include <string>
 
 #include "render_fixture.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

@@ -1,7 +1,7 @@
-// Blackbody emission (render/blackbody.h) against values computed here, independently of its code:
+// Blackbody emission (host/colour/blackbody.h) against values computed here, independently of its code:
 // Planck's law written out again and the CIE 1931 2° table at 5 nm (tests/data/cie1931_2deg_5nm.csv;
 // the implementation integrates its own 1 nm table).
-#include "render/blackbody.h"
+#include "colour/blackbody.h"
 
 #include <gtest/gtest.h>
 

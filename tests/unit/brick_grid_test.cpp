@@ -19,7 +19,7 @@
 
 #include "shared/grid.h"
 #include "volume/brick_grid.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 namespace {

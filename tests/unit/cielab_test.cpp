@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "image/cielab.h"
+#include "colour/cielab.h"
 
 namespace {
 

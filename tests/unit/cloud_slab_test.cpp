@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "test_support.h"
-#include "volume/grid.h"
+#include "volume/dense_grid.h"
 
 namespace narval {
 namespace {

@@ -5,7 +5,7 @@
 //   placed where the file puts it (a field linear in world space, which trilinear filtering
 //   reproduces exactly, read back at density-index points);
 // - blackbody emission from a temperature grid is scale · B((v − offset) · temperatureScale), B the
-//   host's blackbody colour (render/blackbody.h, itself checked against the CIE tables in
+//   host's blackbody colour (host/colour/blackbody.h, itself checked against the CIE tables in
 //   blackbody_test.cpp) through the kernels' table;
 // - nothing at or below 100 K; a constant temperature becomes a constant colour.
 #define EMISSION 1
@@ -19,12 +19,13 @@
 #include <random>
 #include <string>
 
+#include "colour/blackbody.h"
 #include "render/scene_grids.h"
-#include "render/blackbody.h"
 #include "render/scene_upload.h"
 #include "scene/scene.h"
 #include "test_support.h"
 #include "unit/host_context.h"
+#include "vdb_test_file.h"
 
 namespace narval {
 namespace {
@@ -82,7 +83,7 @@ std::array<double, 3> fileWorld(const DenseGrid& g, const double p[3]) {
   return w;
 }
 
-// The heat field of the test file at a world point (host/volume/grid.h, writeVdbTestFile "emission").
+// The heat field of the test file at a world point (tests/vdb_test_file.h, writeVdbTestFile "emission").
 double heatAt(const std::array<double, 3>& w) { return 100 + 10 * w[0] + 20 * w[1] + 30 * w[2]; }
 
 TEST_F(EmissionLookup, AnEmissionGridIsPlacedByItsOwnTransformAndBox) {

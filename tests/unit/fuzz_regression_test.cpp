@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "scene/input_error.h"
-#include "test_support.h"
+#include "core/input_error.h"
 #include "scene/scene.h"
-#include "volume/grid.h"
+#include "test_support.h"
+#include "volume/dense_grid.h"
 
 using narval::DenseGrid;
 using narval::InputError;

@@ -1,4 +1,4 @@
-// Image comparison (host/image/image_compare.h): ΔE76/ΔE2000 statistics on constructed pairs whose
+// Image comparison (host/analysis/image_compare.h): ΔE76/ΔE2000 statistics on constructed pairs whose
 // differences are derived by hand in the comments, the input errors, the bitmap font, and the two
 // maps (ΔE heat map with legend, JND map).
 //
@@ -8,7 +8,7 @@
 // chromas are 0 (so ΔC' = ΔH' = 0) and ΔE00 = |ΔL*| / S_L with
 // S_L = 1 + 0.015 (L̄ − 50)² / sqrt(20 + (L̄ − 50)²) (Sharma, Wu & Dalal 2005, eq. 14).
 // The greys used: 0.125 = 0.5³ (L* = 42), 0.216 = 0.6³ (L* = 53.6), 0.125·1.01³ = 0.505³ (L* = 42.58).
-#include "image/image_compare.h"
+#include "analysis/image_compare.h"
 
 #include <gtest/gtest.h>
 #include <png.h>
@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
+#include "core/input_error.h"
 #include "image/bitmap_font.h"
 #include "image/image.h"
-#include "scene/input_error.h"
 #include "test_support.h"
 
 namespace narval {

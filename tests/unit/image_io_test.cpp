@@ -28,9 +28,9 @@
 #include <string>
 #include <vector>
 
+#include "core/input_error.h"
 #include "image/display_transform.h"
 #include "image/image.h"
-#include "scene/input_error.h"
 #include "shared/tonemap.h"
 #include "test_support.h"
 

@@ -10,12 +10,12 @@
 #include <cmath>
 #include <random>
 
-#include "render/light_cache.h"
+#include "render/device_light_cache.h"
 #include "render/scene_upload.h"
 #include "scene/scene.h"
 #include "shared/light_cache.h"
-#include "volume/grid.h"
 #include "unit/host_context.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {
@@ -38,7 +38,8 @@ std::string boxWithPointLight(const std::string& lightPos) {
 struct Cache {
   DeviceScene ds;
   grid_view grid{};
-  realtime_params params{};
+  march_params march{};
+  node_grid_params layout{};
   std::vector<float> slabs;
 };
 
@@ -48,9 +49,9 @@ Cache buildCache(const std::string& json, int cells, int steps = 16, const Dense
   c.ds = buildDeviceScene(parseScene(json, "light_cache_test.json"), density);
   c.grid = grid_view{density ? density->data.data() : nullptr, density ? density->nx : 1, density ? density->ny : 1,
                      density ? density->nz : 1, c.ds.majorants.data()};
-  c.params.shadow_steps = steps;
-  c.params.light_cache = lightCacheLayout(c.ds, cells);
-  c.slabs = buildLightCacheOnHost(c.ds, &c.grid, c.params);
+  c.march.shadow_steps = steps;
+  c.layout = lightCacheLayout(c.ds, cells);
+  c.slabs = buildLightCacheOnHost(c.ds, &c.grid, c.march, c.layout);
   return c;
 }
 
@@ -59,7 +60,7 @@ double cachedColumn(const Cache& c, const double x[3], uint* status) {
   const vec3 p = vec3_make(float(x[0]), float(x[1]), float(x[2]));
   light_point_view v;
   EXPECT_TRUE(light_view_from(&c.ds.lights[0], p, &v));
-  return light_cache_column(&c.ds.params.medium, &c.params.light_cache, c.slabs.data(), 0, p, v.dir, v.dist, status);
+  return light_cache_column(&c.ds.params.medium, &c.layout, c.slabs.data(), 0, p, v.dir, v.dist, status);
 }
 
 // Length of the segment a → b inside the unit cube [-0.5, 0.5]³ (slab method, double).
@@ -128,9 +129,9 @@ TEST(LightCache, PointLightOutsideMatchesTheChordInsideTheBoxWithinTheTrilinearB
     const double h = 1.0 / cells, bound = 2.0 * h * h / 8 * (0.16 + 0.16 + 0.1024) + 1e-5;
     // The nodes themselves hold the chord, to float rounding.
     const vec3 dims = vec3_from4(c.ds.params.medium.dims);
-    for (int n = 0; n < node_grid_count(&c.params.light_cache); ++n) {
-      const vec3 w = affine_point(c.params.light_cache.index_to_world,
-                                  node_grid_point(&c.params.light_cache, dims, n));
+    for (int n = 0; n < node_grid_count(&c.layout); ++n) {
+      const vec3 w = affine_point(c.layout.index_to_world,
+                                  node_grid_point(&c.layout, dims, n));
       const double x[3] = {w.x, w.y, w.z};
       ASSERT_NEAR(c.slabs[size_t(n)], lengthInside(x, light), 2e-6) << "node " << n;
     }
@@ -195,7 +196,7 @@ TEST(LightCache, LightOnANodeGivesZeroThere) {
   for (const char* pos : {"[0, 0, 0]", "[-0.5, -0.5, -0.5]"}) {
     SCOPED_TRACE(pos);
     const Cache c = buildCache(boxWithPointLight(pos), 8);
-    const node_grid_params& lc = c.params.light_cache;
+    const node_grid_params& lc = c.layout;
     const int centre = std::string(pos) == "[0, 0, 0]" ? 4 : 0;
     const int node = centre + lc.nx * (centre + lc.ny * centre);
     EXPECT_EQ(c.slabs[size_t(node)], 0.0f);
@@ -215,7 +216,6 @@ TEST(LightCache, EmptyGridGivesTransmittanceOneExactly) {
   for (float v : c.slabs) ASSERT_EQ(v, 0.0f);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-0.6, 0.6);
-  realtime_params params = c.params;
   for (int i = 0; i < 200; ++i) {
     const vec3 p = vec3_make(float(u(rng)), float(u(rng)), float(u(rng)));
     light_point_view v;
@@ -223,7 +223,7 @@ TEST(LightCache, EmptyGridGivesTransmittanceOneExactly) {
     ASSERT_TRUE(light_view_from(&c.ds.lights[0], p, &v));
     const vec3 tr = vec3_exp_neg(
         light_cache_optical_depth(narval::test::sceneContext(&c.ds.params, c.ds.lights.data(), &c.grid, &status),
-                                  &params, c.slabs.data(), 0, p, v.dir, v.dist, vec3_make(0, 0, 1)));
+                                  &c.march, &c.layout, c.slabs.data(), 0, p, v.dir, v.dist, vec3_make(0, 0, 1)));
     ASSERT_EQ(tr.x, 1.0f);
     ASSERT_EQ(tr.y, 1.0f);
     ASSERT_EQ(tr.z, 1.0f);

@@ -1,5 +1,5 @@
 // majorant_grid_test.cpp: the majorant grid (host/volume/majorant_grid.*) and its DDA
-// (kernels/shared/majorant.h, the very code the device compiles): the cell values bound the
+// (kernels/shared/majorant_dda.h, the very code the device compiles): the cell values bound the
 // trilinear density (kernels/shared/grid.h, host branch, the device's reconstruction) and are the
 // least such bound made from voxel values; the DDA walks exactly the cells a ray passes through,
 // in order, with contiguous t; the length a kernel may skip is what geometry says. Every expected
@@ -21,11 +21,11 @@
 
 #include "shared/grid.h"
 #include "shared/intersect.h"
-#include "shared/majorant.h"
+#include "shared/majorant_dda.h"
 #include "test_support.h"
-#include "volume/grid.h"
-#include "volume/majorant_grid.h"
 #include "unit/host_context.h"
+#include "volume/dense_grid.h"
+#include "volume/majorant_grid.h"
 
 namespace {
 

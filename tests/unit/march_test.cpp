@@ -7,9 +7,9 @@
 #include "render/scene_upload.h"
 #include "scene/scene.h"
 #include "shared/march.h"
-#include "volume/grid.h"
-#include "volume/majorant_grid.h"
 #include "unit/host_context.h"
+#include "volume/dense_grid.h"
+#include "volume/majorant_grid.h"
 
 namespace narval {
 namespace {

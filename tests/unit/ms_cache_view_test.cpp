@@ -29,20 +29,20 @@ std::vector<float> viewCache(const node_grid_params& c, Tau tau, Value value) {
   return cache;
 }
 
-realtime_params viewParams(int nx, int ny, int nz, int tile) {
-  realtime_params rp{};
-  rp.ms_cache.nx = nx;
-  rp.ms_cache.ny = ny;
-  rp.ms_cache.nz = nz;
-  rp.ms_cache_layout = MS_CACHE_LAYOUT_VIEW;
-  rp.ms_cache_tile = tile;
-  return rp;
+ms_cache_params viewParams(int nx, int ny, int nz, int tile) {
+  ms_cache_params mc{};
+  mc.grid.nx = nx;
+  mc.grid.ny = ny;
+  mc.grid.nz = nz;
+  mc.layout = MS_CACHE_LAYOUT_VIEW;
+  mc.tile = tile;
+  return mc;
 }
 
 // A pixel at its column's centre reads that column alone; one between column centres reads them
 // bilinearly; past the outer centres it reads the edge column (no extrapolation).
 TEST(MsCacheView, PixelsFindTheirColumnsBilinearly) {
-  const realtime_params rp = viewParams(3, 2, 2, 4);  // a 12x8 image in 4x4 tiles
+  const ms_cache_params rp = viewParams(3, 2, 2, 4);  // a 12x8 image in 4x4 tiles
   // Pixel px's centre is px + 0.5, column cx's (cx + 0.5)·4, so in column units u = (px + 0.5)/4 − 0.5.
   ms_view_columns cols = ms_view_locate(&rp, 5, 1);
   // x: u = 5.5/4 − 0.5 = 0.875 → columns 0 and 1 with weights 0.125 and 0.875; y: u = 1.5/4 − 0.5 <
@@ -61,7 +61,7 @@ TEST(MsCacheView, PixelsFindTheirColumnsBilinearly) {
   }
   EXPECT_FLOAT_EQ(total, 1.0f);
   // One column across: every pixel reads it with weight 1 (no second column exists to read).
-  const realtime_params one = viewParams(1, 1, 2, 64);
+  const ms_cache_params one = viewParams(1, 1, 2, 64);
   cols = ms_view_locate(&one, 40, 3);
   EXPECT_EQ(cols.column[0], 0);
   EXPECT_FLOAT_EQ(cols.w[0], 1.0f);
@@ -72,25 +72,25 @@ TEST(MsCacheView, PixelsFindTheirColumnsBilinearly) {
 // "A node holds the slice's mean"): a sample before the first slice reads it, one past the last
 // start reads the last; across columns the values mix bilinearly.
 TEST(MsCacheView, ColumnsAreReadSliceBySliceInOpticalDepth) {
-  const realtime_params rp = viewParams(2, 2, 4, 4);
+  const ms_cache_params rp = viewParams(2, 2, 4, 4);
   auto tau = [](int cx, int cy, int s) { return 0.5f * float(s * s) + 0.1f * float(cx + cy); };  // uneven spacing
   auto value = [](int cx, int cy, int s) { return 2.0f + 3.0f * float(s) + 10.0f * float(cx + 2 * cy); };
-  const std::vector<float> cache = viewCache(rp.ms_cache, tau, value);
+  const std::vector<float> cache = viewCache(rp.grid, tau, value);
   // Pixel (1, 1) of the 8x8 image: u = 1.5/4 − 0.5 < 0 → column (0, 0) alone, slice starts 0, 0.5, 2, 4.5.
   const ms_view_columns corner = ms_view_locate(&rp, 1, 1);
   const float expected[][2] = {{-1.0f, 2}, {0.0f, 2}, {0.49f, 2}, {0.5f, 5}, {1.99f, 5}, {2.0f, 8}, {4.49f, 8},
                                {4.5f, 11}, {9.0f, 11}};
-  for (const auto& e : expected) EXPECT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, e[0], 0.0f).y, e[1]) << e[0];
+  for (const auto& e : expected) EXPECT_EQ(ms_view_lookup(&rp.grid, cache.data(), &corner, e[0], 0.0f).y, e[1]) << e[0];
   // Pixel (3, 4): u = (0.375, 0.625), weights 0.625·0.375, 0.375·0.375, 0.625·0.625, 0.375·0.625 on
   // columns (0,0), (1,0), (0,1), (1,1). At τ = 1 column (0,0) is in slice 1 (starts 0, 0.5, 2), (1,0)
   // and (0,1) too (0.1, 0.6, 2.1), (1,1) too (0.2, 0.7, 2.2): 5 + 10·(0.375 + 2·0.625 … ) bilinear.
   const ms_view_columns mid = ms_view_locate(&rp, 3, 4);
   const float bilinear = 5.0f + 10.0f * (0.375f + 2.0f * 0.625f);
-  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 1.0f, 0.0f).x, bilinear, 1e-5f);
+  EXPECT_NEAR(ms_view_lookup(&rp.grid, cache.data(), &mid, 1.0f, 0.0f).x, bilinear, 1e-5f);
   // At τ = 0.55 column (0,0) is in slice 1 (0.5 ≤ τ) and the others still in slice 0 (0.6, 0.6, 0.7).
   const float mixed = 0.625f * 0.375f * 5.0f + 0.375f * 0.375f * 12.0f + 0.625f * 0.625f * 22.0f +
                       0.375f * 0.625f * 32.0f;
-  EXPECT_NEAR(ms_view_lookup(&rp.ms_cache, cache.data(), &mid, 0.55f, 0.0f).x, mixed, 1e-5f);
+  EXPECT_NEAR(ms_view_lookup(&rp.grid, cache.data(), &mid, 0.55f, 0.0f).x, mixed, 1e-5f);
 }
 
 // A march step from τ to τ + Δτ reads each column's piecewise-constant J weighted by e^{−(τ' − τ)}
@@ -100,12 +100,12 @@ TEST(MsCacheView, ColumnsAreReadSliceBySliceInOpticalDepth) {
 //  - [4, 6] crosses 4.5 into the last slice, which runs on: (8·(1 − e^{−0.5}) + 11·e^{−0.5}(1 − e^{−1.5}))/(1 − e^{−2});
 //  - a step inside one slice reads its value, and a tiny step the slice it starts in.
 TEST(MsCacheView, AStepReadsItsSlicesWeightedByItsOwnAttenuation) {
-  const realtime_params rp = viewParams(2, 2, 4, 4);
+  const ms_cache_params rp = viewParams(2, 2, 4, 4);
   auto tau = [](int cx, int cy, int s) { return 0.5f * float(s * s) + 0.1f * float(cx + cy); };
   auto value = [](int cx, int cy, int s) { return 2.0f + 3.0f * float(s) + 10.0f * float(cx + 2 * cy); };
-  const std::vector<float> cache = viewCache(rp.ms_cache, tau, value);
+  const std::vector<float> cache = viewCache(rp.grid, tau, value);
   const ms_view_columns corner = ms_view_locate(&rp, 1, 1);
-  auto read = [&](float t, float dt) { return double(ms_view_lookup(&rp.ms_cache, cache.data(), &corner, t, dt).x); };
+  auto read = [&](float t, float dt) { return double(ms_view_lookup(&rp.grid, cache.data(), &corner, t, dt).x); };
   const double e = std::exp(1.0);
   EXPECT_NEAR(read(0.3f, 0.5f), (2 * (1 - std::pow(e, -0.2)) + 5 * std::pow(e, -0.2) * (1 - std::pow(e, -0.3))) /
                                     (1 - std::pow(e, -0.5)), 1e-5);
@@ -118,15 +118,15 @@ TEST(MsCacheView, AStepReadsItsSlicesWeightedByItsOwnAttenuation) {
 // A column whose ray meets no medium (τ = −1) drops out and the others' weights are renormalised;
 // with none left the lookup is 0.
 TEST(MsCacheView, ColumnsWithoutMediumDropOut) {
-  const realtime_params rp = viewParams(2, 1, 2, 4);
+  const ms_cache_params rp = viewParams(2, 1, 2, 4);
   auto tau = [](int cx, int, int s) { return cx == 0 ? -1.0f : float(s); };
   auto value = [](int cx, int, int) { return cx == 0 ? 100.0f : 7.0f; };
-  std::vector<float> cache = viewCache(rp.ms_cache, tau, value);
+  std::vector<float> cache = viewCache(rp.grid, tau, value);
   const ms_view_columns cols = ms_view_locate(&rp, 3, 0);  // between the two columns
   EXPECT_GT(cols.w[0], 0.0f);
-  EXPECT_FLOAT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &cols, 0.5f, 0.0f).x, 7.0f);
+  EXPECT_FLOAT_EQ(ms_view_lookup(&rp.grid, cache.data(), &cols, 0.5f, 0.0f).x, 7.0f);
   for (int s = 0; s < 2; ++s) cache[size_t(1 + 2 * s) * MS_CACHE_STRIDE + MS_VIEW_TAU] = -1.0f;
-  EXPECT_EQ(ms_view_lookup(&rp.ms_cache, cache.data(), &cols, 0.5f, 0.0f).x, 0.0f);
+  EXPECT_EQ(ms_view_lookup(&rp.grid, cache.data(), &cols, 0.5f, 0.0f).x, 0.0f);
 }
 
 // Placement in a homogeneous cube [−½, ½]³ of σt = 6 (grey), seen from (0, 0, −4) at 30°: along a
@@ -149,7 +149,7 @@ TEST(MsCacheView, SlicesEndAtEqualStepsOfTheCamerasTransmittance) {
   const DeviceScene ds = buildDeviceScene(scene, nullptr);
   const float global = 1.0f;  // the homogeneous medium's one majorant cell
   const grid_view homogeneous{nullptr, 1, 1, 1, &global};
-  const realtime_params rp = viewParams(4, 4, 5, 2);
+  const ms_cache_params rp = viewParams(4, 4, 5, 2);
   std::vector<float> cache(size_t(4 * 4 * 5) * MS_CACHE_STRIDE, 0.0f);
   for (int column = 0; column < 16; ++column)
     ms_view_place_column(narval::test::sceneContext(&ds.params, ds.lights.data(), &homogeneous), &rp, column,

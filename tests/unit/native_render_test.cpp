@@ -9,9 +9,9 @@
 #include "../../bench/native/native_render.h"
 #include "render/lobe_directions.h"
 #include "render/realtime_renderer.h"
-#include "test_support.h"
 #include "render/render_fixture.h"  // absorptionBoxJson and its analytic transmittance (no device used)
-#include "volume/grid.h"
+#include "test_support.h"
+#include "volume/dense_grid.h"
 
 namespace narval::test {
 namespace {

@@ -10,7 +10,7 @@
 #include <set>
 #include <sstream>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 #include "scene/scene.h"
 #include "test_support.h"
 

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 #include "scene/scene.h"
 #include "test_support.h"
 

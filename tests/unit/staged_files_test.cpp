@@ -1,4 +1,4 @@
-// StagedFiles (image/staged_files.h): outputs land together or not at all.
+// StagedFiles (host/core/staged_files.h): outputs land together or not at all.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "image/atomic_file.h"
-#include "image/staged_files.h"
+#include "core/atomic_file.h"
+#include "core/staged_files.h"
 #include "test_support.h"
 
 namespace narval {

@@ -12,7 +12,7 @@
 #include <random>
 #include <vector>
 
-#include "shared/majorant.h"
+#include "shared/majorant_dda.h"
 #include "shared/march.h"
 #include "shared/tracking.h"
 #include "unit/host_context.h"

@@ -1,4 +1,4 @@
-// The sweep's logic without OpenCL (render/sweep.h): list parsing, names, render order, the
+// The sweep's logic without OpenCL (host/analysis/sweep.h): list parsing, names, render order, the
 // reference row, speed-ups, the table and the figure's size. A fake renderer stands in for the path
 // tracer: its image is a grey level plus noise that shrinks with spp, its time grows with spp.
 #include <gtest/gtest.h>
@@ -6,8 +6,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "render/sweep.h"
-#include "scene/input_error.h"
+#include "analysis/sweep.h"
+#include "core/input_error.h"
 #include "scene/scene.h"
 
 namespace narval {

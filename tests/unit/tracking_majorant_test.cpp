@@ -1,5 +1,5 @@
 // tracking_majorant_test.cpp: delta/spectral tracking and ratio tracking against the majorant grid
-// (kernels/shared/tracking.h walking kernels/shared/majorant.h's DDA), on the host — the very code
+// (kernels/shared/tracking.h walking kernels/shared/majorant_dda.h's DDA), on the host — the very code
 // the device compiles, here with -DCOUNTERS (defined below) so the counts can be checked too.
 //   - the optical budget crosses segment boundaries exactly (hand-made cells, closed-form t),
 //     including a start on a cell face, rays along an axis, rays with zero direction components;
@@ -21,10 +21,10 @@
 #include "shared/medium.h"
 #include "shared/phase.h"
 #include "shared/tracking.h"
-#include "unit/stat_util.h"
-#include "volume/grid.h"
-#include "volume/majorant_grid.h"
 #include "unit/host_context.h"
+#include "unit/stat_util.h"
+#include "volume/dense_grid.h"
+#include "volume/majorant_grid.h"
 
 namespace {
 

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "scene/input_error.h"
+#include "core/input_error.h"
 #include "test_support.h"
 
 namespace narval {

@@ -1,0 +1,66 @@
+// light_cache.h: the light-transmittance cache of the real-time kernels on the device
+// (kernels/shared/light_cache.h holds the math and the layout; kernels/light_cache.cl builds it).
+// Per light, a grid of nodes over the medium's box holding the column density to the light; both
+// real-time kernels read it instead of marching shadow rays. Built once and kept: update() compares
+// what each slab was built from (the medium, the grid, the layout, the shadow step count, that
+// light) and rebuilds only the slabs whose inputs changed, so frames and camera moves rebuild
+// nothing, and moving one light rebuilds its slab alone.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cl/cl_runtime.h"
+#include "render/device_scene.h"
+#include "render/scene_upload.h"
+#include "shared/grid.h"
+#include "shared/structs.h"
+
+namespace narval {
+
+// renderer.lightCache.resolution "auto" (kLightCacheAuto): cells on the longest axis, chosen by
+// measurement (bench/realtime_tuning.sh; bench/RESULTS.md).
+constexpr int kLightCacheAutoResolution = 64;
+
+// The cache's layout for `resolution` cells along the longest world-space axis of the medium's
+// box (kLightCacheAuto: kLightCacheAutoResolution), the other axes in proportion (at least one
+// cell each), nodes = cells + 1 per axis. nx = 0 (no cache) for resolution 0 or no medium.
+// With kLightCacheAuto the resolution is halved until every light's slabs fit in `maxAllocBytes`
+// (the device's largest allocation); an explicit resolution is kept (the allocation then fails
+// with a message naming renderer.lightCache.resolution).
+node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes = SIZE_MAX);
+
+// The column densities of every light's slab computed on the host with the shared header (what the
+// device builds; unit tests and the native baseline use it). `grid` reads the medium's density.
+std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view* grid, const march_params& march,
+                                         const node_grid_params& layout);
+
+class DeviceLightCache {
+ public:
+  // Brings the cache of `layout` (nx > 0) up to date for the scene on `dev` and the shadow rays
+  // of `march`; a no-op when nothing it was built from changed. Throws InputError when the cache exceeds the device's largest allocation (naming
+  // `sceneFile` and renderer.lightCache.resolution).
+  void update(ClRuntime& rt, const DeviceSceneBuffers& dev, const march_params& march, const node_grid_params& layout,
+              const std::string& sceneFile);
+  const cl::Buffer& buffer() const { return buffer_; }
+  int slabsBuilt() const { return slabsBuilt_; }  // light slabs built over this object's life
+  // Their launches' time by profiling events, as the frames are timed (the program build and the
+  // driver's compile on a first launch are not in it).
+  double buildMs() const { return buildMs_; }
+  size_t bytes() const { return bytes_; }
+  uint32_t status() const { return status_; }     // STATUS_* bits the builds met
+
+ private:
+  std::string mediumKey_;  // medium, grid identity, layout and shadow steps the slabs were built from
+  std::vector<light_params> lights_;  // each slab's light when it was built
+  cl::Program program_;
+  NamedKernel kernel_;
+  cl::Buffer buffer_, statusBuf_;
+  int slabsBuilt_ = 0;
+  double buildMs_ = 0;
+  size_t bytes_ = 0;
+  uint32_t status_ = 0;
+};
+
+}  // namespace narval

@@ -1,0 +1,135 @@
+#include "render/realtime_params.h"
+
+#include "render/device_light_cache.h"
+#include "render/node_grid_layout.h"
+
+namespace narval {
+namespace {
+
+// The lobe variants' defaults where the scene leaves a key out (0); eq7's are the dissertation's.
+int lobeShadowAreaSamples(const LobeSettings& l) {
+  if (l.shadowAreaSamples > 0) return l.shadowAreaSamples;
+  switch (l.variant) {
+    case LobeVariant::Eq7: return 1;
+    case LobeVariant::Corrected: return 4;
+  }
+  throw std::logic_error("lobeShadowAreaSamples: not a LobeVariant");
+}
+
+int lobeViewSteps(const LobeSettings& l) {
+  if (l.viewSteps > 0) return l.viewSteps;
+  switch (l.variant) {
+    case LobeVariant::Eq7: return 24;
+    case LobeVariant::Corrected: return 16;
+  }
+  throw std::logic_error("lobeViewSteps: not a LobeVariant");
+}
+
+int areaLightPhase(AreaLightPhase a) {
+  switch (a) {
+    case AreaLightPhase::Points: return AREA_LIGHT_POINTS;
+    case AreaLightPhase::Exact: return AREA_LIGHT_EXACT;
+  }
+  throw std::logic_error("areaLightPhase: not an AreaLightPhase");
+}
+
+// What both algorithms' marches take; the ray marcher adds its shadow weighting and octaves.
+march_params marchParams(int steps, int shadowSteps, float minTransmittance, int areaLightSamples,
+                         AreaLightPhase phase, int shadowAreaSamples) {
+  march_params p{};
+  p.steps = steps;
+  p.shadow_steps = shadowSteps;
+  p.min_transmittance = minTransmittance;
+  p.area_light_samples = areaLightSamples;
+  p.shadow_area_samples = shadowAreaSamples;
+  p.area_light_phase = areaLightPhase(phase);
+  p.shadow_weighting = SHADOW_WEIGHTING_AREA;
+  p.octaves = 1;
+  return p;
+}
+
+march_params raymarchMarch(const RaymarchSettings& r) {
+  march_params p = marchParams(r.steps, r.shadowSteps, r.minTransmittance, r.areaLightSamples, r.areaLightPhase,
+                               r.shadowAreaSamples);
+  if (r.shadowWeighting == ShadowWeighting::Phase) p.shadow_weighting = SHADOW_WEIGHTING_PHASE;
+  if (r.multipleScattering == MultipleScattering::Octaves) p.octaves = r.octaves;
+  p.octave_a = r.octaveScattering;
+  p.octave_b = r.octaveExtinction;
+  p.octave_c = r.octavePhase;
+  return p;
+}
+
+march_params lobeMarch(const LobeSettings& l) {
+  return marchParams(l.firstHitSteps, l.shadowSteps, l.minTransmittance, l.areaLightSamples, l.areaLightPhase,
+                     lobeShadowAreaSamples(l));
+}
+
+lobe_params lobeParams(const LobeSettings& l) {
+  lobe_params p{};
+  p.depth_factor = l.depthFactor;
+  p.radius = l.lobeRadius;
+  p.points = l.lobePoints;
+  p.view_steps = lobeViewSteps(l);
+  p.variant = l.variant == LobeVariant::Corrected ? LOBE_CORRECTED : LOBE_EQ7;
+  return p;
+}
+
+// The view layout aims its paths at the camera (closure camera) and filters its columns.
+ms_cache_params msCacheParams(const MsCacheSettings& mc, bool on, const DeviceScene& ds) {
+  ms_cache_params p{};
+  p.tile = mc.tile;
+  switch (mc.layout) {
+    case MsCacheLayout::Grid:
+      p.layout = MS_CACHE_LAYOUT_GRID;
+      if (on) p.grid = nodeGridLayout(ds, mc.resolution);
+      break;
+    case MsCacheLayout::View:  // columns over the image, slices along them (ms_cache_view.h)
+      p.layout = MS_CACHE_LAYOUT_VIEW;
+      if (on && ds.params.has_medium) {
+        p.grid.nx = (ds.params.camera.width + mc.tile - 1) / mc.tile;
+        p.grid.ny = (ds.params.camera.height + mc.tile - 1) / mc.tile;
+        p.grid.nz = mc.slices;
+      }
+      p.filter = mc.filter;
+      p.filter_tolerance = mc.filterTolerance;
+      p.filter_twicing = mc.filter > 0 && mc.filterTwicing;
+      break;
+  }
+  switch (mc.closure) {
+    case MsCacheClosure::Linear: p.closure = MS_CACHE_CLOSURE_LINEAR; break;
+    case MsCacheClosure::Hg: p.closure = MS_CACHE_CLOSURE_HG; break;
+    case MsCacheClosure::Camera: p.closure = MS_CACHE_CLOSURE_CAMERA; break;
+  }
+  if (mc.layout == MsCacheLayout::View) p.closure = MS_CACHE_CLOSURE_CAMERA;
+  switch (mc.interpolation) {
+    case MsCacheInterpolation::Geometric: p.interpolation = MS_CACHE_INTERPOLATION_GEOMETRIC; break;
+    case MsCacheInterpolation::Linear: p.interpolation = MS_CACHE_INTERPOLATION_LINEAR; break;
+  }
+  p.direct = on && mc.direct;
+  // The guide draws about the lights where the paths draw from the phase function (phase_guide.h).
+  p.guide = on && p.closure == MS_CACHE_CLOSURE_CAMERA ? mc.guide : 0.0f;
+  return p;
+}
+
+}  // namespace
+
+RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes) {
+  const RendererSettings& r = scene.renderer;
+  RealtimeParams p;
+  switch (r.algorithm) {
+    case Algorithm::Raymarch:
+      p.march = raymarchMarch(r.raymarch);
+      p.msCache = msCacheParams(r.raymarch.msCache, r.raymarch.multipleScattering == MultipleScattering::Cache, ds);
+      break;
+    case Algorithm::Lobe:
+      p.march = lobeMarch(r.lobe);
+      p.lobe = lobeParams(r.lobe);
+      break;
+    case Algorithm::Pathtrace: throw std::logic_error("realtimeParams: the path tracer has none");
+  }
+  // No light loop when the multiple-scattering cache holds the direct light: no shadow rays to cache.
+  if (!p.msCache.direct) p.lightCache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
+  return p;
+}
+
+}  // namespace narval

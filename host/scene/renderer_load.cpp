@@ -1,0 +1,238 @@
+// renderer_load.cpp: the scene's "renderer" object, a reader per section (docs/scene-format.md).
+#include "scene/renderer_load.h"
+
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+
+namespace narval {
+namespace scene_detail {
+namespace {
+
+constexpr int64_t kMaxImageSide = 16384;  // keeps width * height well inside an int
+
+const EnumNames<GridStorage> kGridStorages = {{"auto", GridStorage::Auto},
+                                              {"image", GridStorage::Image},
+                                              {"buffer", GridStorage::Buffer},
+                                              {"bricks", GridStorage::Bricks}};
+const EnumNames<MultipleScattering> kMultipleScattering = {{"none", MultipleScattering::None},
+                                                           {"octaves", MultipleScattering::Octaves},
+                                                           {"cache", MultipleScattering::Cache}};
+const EnumNames<LightSampling> kLightSamplings = {
+    {"all", LightSampling::All}, {"power", LightSampling::Power}, {"fluence", LightSampling::Fluence}};
+const EnumNames<AreaLightPhase> kAreaLightPhases = {{"points", AreaLightPhase::Points},
+                                                     {"exact", AreaLightPhase::Exact}};
+const EnumNames<MsCacheClosure> kMsCacheClosures = {
+    {"linear", MsCacheClosure::Linear}, {"hg", MsCacheClosure::Hg}, {"camera", MsCacheClosure::Camera}};
+const EnumNames<MsCacheInterpolation> kMsCacheInterpolations = {{"geometric", MsCacheInterpolation::Geometric},
+                                                                {"linear", MsCacheInterpolation::Linear}};
+const EnumNames<ShadowWeighting> kShadowWeightings = {{"area", ShadowWeighting::Area},
+                                                      {"phase", ShadowWeighting::Phase}};
+const EnumNames<MsCacheLayout> kMsCacheLayouts = {{"grid", MsCacheLayout::Grid}, {"view", MsCacheLayout::View}};
+const EnumNames<MsCacheAllocationKind> kMsCacheAllocations = {{"even", MsCacheAllocationKind::Even},
+                                                              {"perceptual", MsCacheAllocationKind::Perceptual}};
+const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
+const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
+                                          {"raymarch", Algorithm::Raymarch},
+                                          {"lobe", Algorithm::Lobe}};
+
+// A transmittance below which a march stops: [0, 1) (0 = never stops; 1 would stop at once).
+float readMinTransmittance(ObjectReader& r, float fallback) {
+  const float v = r.getFloat("minTransmittance", fallback);
+  if (!(v >= 0 && v < 1))
+    r.context().fail(r.keyOf("minTransmittance"), "must be in [0, 1) (0 = never stop), got " + formatNumber(v));
+  return v;
+}
+
+// renderer.raymarch/lobe.areaLightPhase; with "exact", a given areaLightSamples is said to be ignored.
+AreaLightPhase readAreaLightPhase(ObjectReader& r, AreaLightPhase fallback) {
+  const AreaLightPhase v = readEnum(r, "areaLightPhase", kAreaLightPhases, fallback);
+  if (v == AreaLightPhase::Exact && r.find("areaLightSamples"))
+    r.context().warn(r.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
+  return v;
+}
+
+ToneMapping readToneMapping(ObjectReader& r, ToneMapping fallback) {
+  const json* v = r.find("toneMapping");
+  if (!v) return fallback;
+  // Listing 4.1 writes a boolean; a name picks the operator.
+  if (v->is_boolean()) return v->get<bool>() ? ToneMapping::Aces : ToneMapping::None;
+  if (!v->is_string())
+    r.context().fail(r.keyOf("toneMapping"), "expected a boolean or one of " + enumNameList(kToneMappingNames) +
+                                                 ", got " + v->type_name());
+  return toEnum(r.context(), *v, r.keyOf("toneMapping"), kToneMappingNames);
+}
+
+void readResolution(ObjectReader& r, RendererSettings& s) {
+  const std::string key = r.keyOf("resolution");
+  const json& v = r.require("resolution");
+  if (!v.is_array() || v.size() != 2)
+    r.context().fail(key, std::string("expected an array of 2 integers [width, height], got ") +
+                              (v.is_array() ? std::to_string(v.size()) + " elements" : v.type_name()));
+  int* sides[2] = {&s.width, &s.height};
+  for (size_t i = 0; i < 2; ++i)
+    *sides[i] = static_cast<int>(checkIntRange(r.context(), indexKey(key, i),
+                                               toInteger(r.context(), v[i], indexKey(key, i)), 1, kMaxImageSide));
+}
+
+PathtraceSettings readPathtrace(JsonContext& ctx, const json& value, const std::string& key, PathtraceSettings s) {
+  ObjectReader p(ctx, value, key);
+  s.lightSampling = readEnum(p, "lightSampling", kLightSamplings, s.lightSampling);
+  s.shadowRoulette = readUnitInterval(p, "shadowRoulette", s.shadowRoulette);
+  p.reportUnknown();
+  return s;
+}
+
+MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::string& key, MsCacheSettings s) {
+  ObjectReader mc(ctx, value, key);
+  s.closure = readEnum(mc, "closure", kMsCacheClosures, s.closure);
+  s.interpolation = readEnum(mc, "interpolation", kMsCacheInterpolations, s.interpolation);
+  s.layout = readEnum(mc, "layout", kMsCacheLayouts, s.layout);
+  if (s.layout == MsCacheLayout::View && s.closure != MsCacheClosure::Camera && mc.find("closure"))
+    ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
+  const bool view = s.layout == MsCacheLayout::View;
+  for (const std::string key :
+       {"resolution", "interpolation", "tile", "slices", "filter", "filterTolerance", "filterTwicing", "allocation"})
+    if (mc.find(key) && view != (key == "tile" || key == "slices" || key == "filter" || key == "filterTolerance" ||
+                                 key == "filterTwicing" || key == "allocation"))
+      ctx.warn(mc.keyOf(key), std::string("applies to layout \"") + (view ? "grid" : "view") + "\"; \"" +
+                                  (view ? "view" : "grid") + "\" ignores it");
+  s.resolution = readInt(mc, "resolution", s.resolution, 1, 256);
+  s.tile = readInt(mc, "tile", s.tile, 1, 256);
+  s.direct = mc.getBool("direct", s.direct);
+  if (s.direct && !view && s.closure != MsCacheClosure::Camera)
+    ctx.fail(mc.keyOf("direct"), "needs closure \"camera\" or layout \"view\" (a node must hold the light "
+                                 "scattered towards the camera)");
+  s.slices = readInt(mc, "slices", s.slices, 2, 64);
+  s.filter = readNonNegative(mc, "filter", s.filter);
+  if (s.filter > 8) ctx.fail(mc.keyOf("filter"), "must be at most 8 (columns), got " + formatNumber(s.filter));
+  s.filterTolerance = mc.getFloat("filterTolerance", s.filterTolerance);
+  if (!(s.filterTolerance > 0))
+    ctx.fail(mc.keyOf("filterTolerance"), "must be positive, got " + formatNumber(s.filterTolerance));
+  s.filterTwicing = mc.getBool("filterTwicing", s.filterTwicing);
+  if (s.filterTwicing && view && !(s.filter > 0))
+    ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
+  s.allocation = readEnum(mc, "allocation", kMsCacheAllocations, s.allocation);
+  s.guide = readNonNegative(mc, "guide", s.guide);
+  if (!(s.guide < 1))
+    ctx.fail(mc.keyOf("guide"), "must be below 1 (the phase function's share covers every direction), got " +
+                                    formatNumber(s.guide));
+  else if (s.guide > 0 && !view && s.closure != MsCacheClosure::Camera)
+    ctx.fail(mc.keyOf("guide"), "needs closure \"camera\" or layout \"view\" (the uniform closures draw no "
+                                "phase-function directions to guide)");
+  s.paths = readInt(mc, "paths", s.paths, 1, 1 << 20);
+  s.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.pathsPerLaunch, 1, 1 << 20);
+  mc.reportUnknown();
+  return s;
+}
+
+RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::string& key, RaymarchSettings s) {
+  ObjectReader m(ctx, value, key);
+  s.steps = readInt(m, "steps", s.steps, 1);
+  s.shadowSteps = readInt(m, "shadowSteps", s.shadowSteps, 1);
+  s.octaves = readInt(m, "octaves", s.octaves, 1, 16);
+  s.octaveScattering = readUnitInterval(m, "octaveScattering", s.octaveScattering);
+  s.octaveExtinction = readUnitInterval(m, "octaveExtinction", s.octaveExtinction);
+  s.octavePhase = readUnitInterval(m, "octavePhase", s.octavePhase);
+  if (s.octaveScattering > s.octaveExtinction)
+    ctx.fail(m.keyOf("octaveScattering"),
+             "must not exceed octaveExtinction (" + formatNumber(s.octaveExtinction) + ") or the octaves add energy");
+  s.minTransmittance = readMinTransmittance(m, s.minTransmittance);
+  s.areaLightSamples = readInt(m, "areaLightSamples", s.areaLightSamples, 1, 16);
+  s.areaLightPhase = readAreaLightPhase(m, s.areaLightPhase);
+  s.shadowAreaSamples = readInt(m, "shadowAreaSamples", s.shadowAreaSamples, 1, 16);
+  s.shadowWeighting = readEnum(m, "shadowWeighting", kShadowWeightings, s.shadowWeighting);
+  s.multipleScattering = readEnum(m, "multipleScattering", kMultipleScattering,
+                                  s.octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::None);
+  if (s.octaves > 1 && s.multipleScattering != MultipleScattering::Octaves)
+    ctx.fail(m.keyOf("octaves"), "applies only with multipleScattering \"octaves\"");
+  if (const json* c = m.find("msCache")) s.msCache = readMsCache(ctx, *c, m.keyOf("msCache"), s.msCache);
+  m.reportUnknown();
+  return s;
+}
+
+// `emits`: some material emits (firstHitSteps then serves both variants).
+LobeSettings readLobe(JsonContext& ctx, const json& value, const std::string& key, bool emits, LobeSettings s) {
+  ObjectReader l(ctx, value, key);
+  s.variant = readEnum(l, "variant", kLobeVariants, s.variant);
+  // The corrected estimator has no first-hit search and no fixed depth (lobe.h, C2); the first
+  // hit's step count still marches an emitting medium's light in both variants.
+  if (s.variant == LobeVariant::Corrected)
+    for (const char* k : {"depthFactor", "firstHitSteps"})
+      if (l.find(k) && !(emits && std::string(k) == "firstHitSteps"))
+        ctx.warn(l.keyOf(k), "applies to variant \"eq7\"; \"corrected\" ignores it");
+  s.depthFactor = readNonNegative(l, "depthFactor", s.depthFactor);
+  s.lobePoints = readInt(l, "lobePoints", s.lobePoints, 1);
+  s.lobeRadius = readNonNegative(l, "lobeRadius", s.lobeRadius);
+  s.shadowSteps = readInt(l, "shadowSteps", s.shadowSteps, 1);
+  s.firstHitSteps = readInt(l, "firstHitSteps", s.firstHitSteps, 1);
+  if (l.find("viewSteps")) s.viewSteps = readInt(l, "viewSteps", 1, 1);
+  s.minTransmittance = readMinTransmittance(l, s.minTransmittance);
+  s.areaLightSamples = readInt(l, "areaLightSamples", s.areaLightSamples, 1, 16);
+  s.areaLightPhase = readAreaLightPhase(l, s.areaLightPhase);
+  if (l.find("shadowAreaSamples")) s.shadowAreaSamples = readInt(l, "shadowAreaSamples", 1, 1, 16);
+  l.reportUnknown();
+  return s;
+}
+
+LightCacheSettings readLightCache(JsonContext& ctx, const json& value, const std::string& key, LightCacheSettings s) {
+  ObjectReader c(ctx, value, key);
+  if (const json* res = c.find("resolution")) {
+    if (res->is_string() && res->get<std::string>() == "auto")
+      s.resolution = kLightCacheAuto;
+    else if (res->is_number())
+      s.resolution = static_cast<int>(
+          checkIntRange(ctx, c.keyOf("resolution"), toInteger(ctx, *res, c.keyOf("resolution")), 0, 1024));
+    else
+      ctx.fail(c.keyOf("resolution"),
+               "expected \"auto\" or a number of cells (0 = off), got " +
+                   (res->is_string() ? "\"" + res->get<std::string>() + "\"" : std::string(res->type_name())));
+  }
+  c.reportUnknown();
+  return s;
+}
+
+}  // namespace
+
+RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::string& key, bool emits) {
+  ObjectReader r(ctx, value, key);
+  RendererSettings s;
+  readResolution(r, s);
+  s.spp = readInt(r, "spp", s.spp, 1);
+  s.bounces = readInt(r, "bounces", s.bounces, 0);
+  s.hdr = r.getBool("HDR", s.hdr);
+  s.toneMapping = readToneMapping(r, s.toneMapping);
+  s.exposure = r.getFloat("exposure", s.exposure);
+  s.algorithm = readEnum(r, "algorithm", kAlgorithms, s.algorithm);
+  s.storage = readEnum(r, "storage", kGridStorages, s.storage);
+  s.seed = static_cast<uint32_t>(checkIntRange(ctx, r.keyOf("seed"), r.getInteger("seed", s.seed), 0,
+                                               std::numeric_limits<uint32_t>::max()));
+  if (const json* v = r.find("pathtrace")) s.pathtrace = readPathtrace(ctx, *v, r.keyOf("pathtrace"), s.pathtrace);
+  if (const json* v = r.find("raymarch")) s.raymarch = readRaymarch(ctx, *v, r.keyOf("raymarch"), s.raymarch);
+  if (const json* v = r.find("lobe")) s.lobe = readLobe(ctx, *v, r.keyOf("lobe"), emits, s.lobe);
+  if (const json* v = r.find("lightCache")) s.lightCache = readLightCache(ctx, *v, r.keyOf("lightCache"), s.lightCache);
+  r.reportUnknown();
+  return s;
+}
+
+}  // namespace scene_detail
+
+using scene_detail::kAlgorithms;
+using scene_detail::kGridStorages;
+
+const char* gridStorageName(GridStorage s) { return enumName(kGridStorages, s); }
+
+const char* algorithmName(Algorithm a) { return enumName(kAlgorithms, a); }
+
+bool isRealtime(Algorithm a) {
+  switch (a) {
+    case Algorithm::Pathtrace: return false;
+    case Algorithm::Raymarch:
+    case Algorithm::Lobe: return true;
+  }
+  throw std::logic_error("isRealtime: not an Algorithm");
+}
+
+bool algorithmFromName(const std::string& name, Algorithm* out) { return enumFromName(kAlgorithms, name, out); }
+
+}  // namespace narval
