@@ -102,7 +102,7 @@
 #define NARVAL_LOBE_H
 
 #include "shared/camera.h"
-#include "shared/light_cache.h"
+#include "shared/march_lights.h"
 #include "shared/phase.h"
 
 /* Halvings of the first-hit step: x0 is placed within Δ/64 past the density's zero crossing. */
@@ -159,38 +159,6 @@ static inline vec3 lobe_transmittance_between(KERNEL_CONTEXT_PARAM, vec3 a, vec3
                                                   tau_limit));
 }
 
-/* Adds to *in_sum the light of every light at lobe point P scattered towards c (direction −d, d the
- * lobe direction that placed P): Σ_k p(cos θ) · Tr(P → light_k) · I_k / |light_k − P|². Terms are
- * added light by light into *in_sum, the order Eq. 7's pixels were recorded with. */
-static inline void lobe_add_inscattered(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
-                                        NV_PRIVATE const node_grid_params* lc, NV_GLOBAL const float* light_cache, vec3 P, vec3 d, NV_PRIVATE vec3* in_sum) {
-  NV_CONSTANT const scene_params* s = ctx->scene;
-  NV_CONSTANT const light_params* lights = ctx->lights;
-  NV_PRIVATE uint* status = &ctx->status;
-  NV_CONSTANT const medium_params* m = &s->medium;
-  const vec3 w_out = vec3_scale(d, -1.0f); /* from P towards c */
-  for (int k = 0; k < s->num_lights; ++k) {
-    light_point_view v;
-    if (!light_view_from(&lights[k], P, &v)) continue;
-    const vec3 to_light = v.dir;
-    const vec3 tr =
-        vec3_exp_neg(light_cache_optical_depth(KERNEL_CONTEXT_ARG, mp, lc, light_cache, k, P, to_light, v.dist, d));
-    if (mp->area_light_samples > 1 || mp->area_light_phase != AREA_LIGHT_POINTS) {
-      /* rectangles as K×K points or integrated exactly (march_light_phase) */
-      *in_sum = vec3_add(*in_sum, vec3_mul(tr, march_light_phase(&lights[k], P, m->phase, d, mp->area_light_phase,
-                                                                  mp->area_light_samples)));
-      continue;
-    }
-    /* w_in: the light's propagation direction, light → P. */
-    const float f = phase_eval(m->phase, vec3_scale(to_light, -1.0f), w_out);
-    if (!(f > 0.0f)) {
-      if (f != f) *status |= STATUS_NAN; /* e.g. a NaN g: not dropped silently */
-      continue;
-    }
-    *in_sum = vec3_add(*in_sum, vec3_scale(vec3_mul(tr, v.intensity), f / (v.range * v.range)));
-  }
-}
-
 /* σs/σt per channel (0 where σt = 0). */
 static inline vec3 lobe_albedo(NV_CONSTANT const medium_params* m) {
   const vec3 sig_s = vec3_from4(m->sigma_s);
@@ -234,7 +202,7 @@ static inline vec3 lobe_radiance_eq7(KERNEL_CONTEXT_PARAM, NV_PRIVATE const marc
     const vec3 P = vec3_madd(c, d, lp->radius);
     if (view_term)
       tr_sum = vec3_add(tr_sum, lobe_transmittance_between(KERNEL_CONTEXT_ARG, x0, P, lp->view_steps, tau_limit));
-    lobe_add_inscattered(KERNEL_CONTEXT_ARG, mp, lc, light_cache, P, d, &in_sum);
+    march_light_sum(KERNEL_CONTEXT_ARG, mp, lc, light_cache, P, d, MARCH_LIGHTS_LOBE, &in_sum);
   }
   const float fn = (float)n;
   const vec3 tr_mean = vec3_make(tr_sum.x / fn, tr_sum.y / fn, tr_sum.z / fn);
@@ -281,7 +249,8 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_PRIVATE cons
     const vec3 dtau = vec3_scale(march_sigma_t(KERNEL_CONTEXT_ARG, seg, t), it.delta);
     const float w = nv_exp(-vec3_average(tau)) * (1.0f - nv_exp(-vec3_average(dtau)));
     vec3 S = vec3_splat(0.0f);
-    if (w > 0.0f) lobe_add_inscattered(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(origin, dir, t), dir, &S);
+    if (w > 0.0f)
+      march_light_sum(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(origin, dir, t), dir, MARCH_LIGHTS_LOBE, &S);
     const float ws = w * vec3_average(S);
     w_sum += w;
     wt_sum += w * t;
@@ -308,7 +277,7 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_PRIVATE cons
     const vec3 d = lobe_direction(tx, ty, dir, dirs[i]);
     medium_segment inside;
     const float reach = ball_inside ? r : medium_intersect(m, c, d, 0.0f, r, &inside) ? inside.t1 : 0.0f;
-    lobe_add_inscattered(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(c, d, reach), d, &in_sum);
+    march_light_sum(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(c, d, reach), d, MARCH_LIGHTS_LOBE, &in_sum);
   }
   const float fn = (float)n;
   const vec3 in_mean = vec3_make(in_sum.x / fn, in_sum.y / fn, in_sum.z / fn);

@@ -1,6 +1,6 @@
 /* ms_cache.h: the multiple-scattering cache of the ray marcher (DESIGN.md "Real-time caches").
  * The radiance arriving at a point x splits into the unscattered light of the scene's lights,
- * which the ray marcher integrates itself with the phase function (raymarch_light_sum, through the
+ * which the ray marcher integrates itself with the phase function (march_light_sum, through the
  * light-transmittance cache), and the rest: light scattered at least once, and the background
  * seen through the medium. The rest varies slowly in space and direction; this cache holds its
  * directional average (and first moment, below) per node of a grid over the medium's box

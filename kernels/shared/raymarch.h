@@ -76,58 +76,10 @@
 #define NARVAL_RAYMARCH_H
 
 #include "shared/camera.h"
-#include "shared/light_cache.h"
+#include "shared/march_lights.h"
 #include "shared/ms_cache.h"
 #include "shared/ms_cache_view.h"
 #include "shared/phase.h"
-
-/* Light arriving at x and scattered towards the camera, per unit σs: Σ_lights (I/d²) ⊙
- * Σ_{i<N} aⁱ p(g cⁱ, μ) exp(−bⁱ τ). view_dir points away from the camera. */
-static inline vec3 raymarch_light_sum(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
-                                      NV_PRIVATE const node_grid_params* lc, NV_GLOBAL const float* light_cache, vec3 x,
-                                      vec3 view_dir) {
-  NV_CONSTANT const scene_params* s = ctx->scene;
-  NV_CONSTANT const light_params* lights = ctx->lights;
-  NV_CONSTANT const medium_params* m = &s->medium;
-  vec3 sum = vec3_splat(0.0f);
-  for (int l = 0; l < s->num_lights; ++l) {
-    light_point_view v;
-    if (!light_view_from(&lights[l], x, &v)) continue;
-    const vec3 dir = v.dir;
-    const vec3 tau = light_cache_optical_depth(KERNEL_CONTEXT_ARG, mp, lc, light_cache, l, x, dir, v.dist, view_dir);
-    if (mp->area_light_samples > 1 || mp->area_light_phase != AREA_LIGHT_POINTS) {
-      /* Rectangles as K×K points or integrated exactly (march_light_phase), one shadow for all. */
-      const int K = mp->area_light_samples, mode = mp->area_light_phase;
-      vec3 lit = vec3_mul(vec3_exp_neg(tau), march_light_phase(&lights[l], x, m->phase, view_dir, mode, K));
-      float ai = 1.0f, bi = 1.0f, ci = 1.0f;
-      for (int i = 1; i < mp->octaves; ++i) {
-        ai *= mp->octave_a;
-        bi *= mp->octave_b;
-        ci *= mp->octave_c;
-        lit = vec3_add(lit, vec3_scale(vec3_mul(vec3_exp_neg(vec3_scale(tau, bi)),
-                                                march_light_phase(&lights[l], x, phase_scaled(m->phase, ci), view_dir, mode, K)),
-                                       ai));
-      }
-      sum = vec3_add(sum, lit);
-      continue;
-    }
-    /* K = 1: the centre alone, the dissertation's point light, with its arithmetic. */
-    /* Octave 0: plain single scattering. */
-    vec3 oct = vec3_scale(vec3_exp_neg(tau), phase_eval(m->phase, view_dir, dir));
-    if (mp->octaves > 1) {
-      float ai = 1.0f, bi = 1.0f, ci = 1.0f;
-      for (int i = 1; i < mp->octaves; ++i) {
-        ai *= mp->octave_a;
-        bi *= mp->octave_b;
-        ci *= mp->octave_c;
-        const float p = phase_eval(phase_scaled(m->phase, ci), view_dir, dir);
-        oct = vec3_add(oct, vec3_scale(vec3_exp_neg(vec3_scale(tau, bi)), ai * p));
-      }
-    }
-    sum = vec3_add(sum, vec3_mul(vec3_scale(v.intensity, 1.0f / (v.range * v.range)), oct));
-  }
-  return sum;
-}
 
 /* What a march has gathered so far: in-scattered radiance L and view-ray transmittance T. */
 typedef struct raymarch_accum {
@@ -181,9 +133,10 @@ static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march
     vec3 S = vec3_splat(0.0f);
     if (!vec3_is_zero(sigma_s)) {
       /* The lights' unscattered light, unless the cache holds it too (ms_cache.h, "Direct"). */
-      vec3 Li = mc->grid.nx > 0 && mc->direct
-                    ? vec3_splat(0.0f)
-                    : raymarch_light_sum(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(origin, dir, t), dir);
+      vec3 Li = vec3_splat(0.0f);
+      if (!(mc->grid.nx > 0 && mc->direct))
+        march_light_sum(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(origin, dir, t), dir, MARCH_LIGHTS_RAYMARCH,
+                        &Li);
       if (mc->grid.nx > 0) /* the rest of the radiance arriving there (ms_cache.h), over the step */
         Li = vec3_add(Li, raymarch_ms_cache(mc, m, ms_cache, cols, vec3_madd(seg->o, seg->d, t), tau, dtau, dir));
       S = vec3_mul(sigma_s, Li);

@@ -53,7 +53,7 @@ std::string boxScene(const std::string& medium, const std::string& renderer) {
 
 // STATUS_NAN from a valid value that overflows: `--set` makes the point light's intensity 3e38 W/sr
 // (finite, non-negative: the loader takes it). The ray marcher's in-scatter term scales I by 1/d²
-// first (raymarch_light_sum), and the centre pixel of a 3 × 3 image looks straight through the light
+// first (march_light_sum), and the centre pixel of a 3 × 3 image looks straight through the light
 // at the box centre, so its midpoint samples lie within Δ/2 = 1/120 of it: I/d² ≥ 3e38·14400 = +inf
 // in float, and the pixel's L is non-finite. The kernel writes 0 and raises STATUS_NAN; the binary
 // exits 0, prints exactly the NaN warning (and neither other status line), and the stats say
