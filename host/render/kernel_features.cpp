@@ -81,12 +81,13 @@ std::string sceneBuildOptions(const DeviceScene& ds) {
 }
 
 std::string gridStorageBuildOption(GridStorage storage) {
+#define GRID_STORAGE_FLAG(name, cxx, define) \
+  case GridStorage::cxx: return define;
   switch (storage) {
-    case GridStorage::Buffer: return "-DGRID_STORAGE_BUFFER";
-    case GridStorage::Bricks: return "-DGRID_STORAGE_BRICKS";
-    case GridStorage::Image: return "";
+    GRID_STORAGE_KINDS(GRID_STORAGE_FLAG)
     case GridStorage::Auto: break;
   }
+#undef GRID_STORAGE_FLAG
   throw std::invalid_argument("gridStorageBuildOption: the storage must be resolved (not auto)");
 }
 

@@ -11,10 +11,9 @@ namespace {
 
 constexpr int64_t kMaxImageSide = 16384;  // keeps width * height well inside an int
 
-const EnumNames<GridStorage> kGridStorages = {{"auto", GridStorage::Auto},
-                                              {"image", GridStorage::Image},
-                                              {"buffer", GridStorage::Buffer},
-                                              {"bricks", GridStorage::Bricks}};
+#define GRID_STORAGE_NAME(name, cxx, define) {name, GridStorage::cxx},
+const EnumNames<GridStorage> kGridStorages = {{"auto", GridStorage::Auto}, GRID_STORAGE_KINDS(GRID_STORAGE_NAME)};
+#undef GRID_STORAGE_NAME
 const EnumNames<MultipleScattering> kMultipleScattering = {{"none", MultipleScattering::None},
                                                            {"octaves", MultipleScattering::Octaves},
                                                            {"cache", MultipleScattering::Cache}};
@@ -32,9 +31,9 @@ const EnumNames<MsCacheLayout> kMsCacheLayouts = {{"grid", MsCacheLayout::Grid},
 const EnumNames<MsCacheAllocationKind> kMsCacheAllocations = {{"even", MsCacheAllocationKind::Even},
                                                               {"perceptual", MsCacheAllocationKind::Perceptual}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
-const EnumNames<Algorithm> kAlgorithms = {{"pathtrace", Algorithm::Pathtrace},
-                                          {"raymarch", Algorithm::Raymarch},
-                                          {"lobe", Algorithm::Lobe}};
+#define ALGORITHM_NAME(cxx, name, realtime) {name, Algorithm::cxx},
+const EnumNames<Algorithm> kAlgorithms = {ALGORITHMS(ALGORITHM_NAME)};
+#undef ALGORITHM_NAME
 
 // A transmittance below which a march stops: [0, 1) (0 = never stops; 1 would stop at once).
 float readMinTransmittance(ObjectReader& r, float fallback) {
@@ -225,11 +224,10 @@ const char* gridStorageName(GridStorage s) { return enumName(kGridStorages, s); 
 const char* algorithmName(Algorithm a) { return enumName(kAlgorithms, a); }
 
 bool isRealtime(Algorithm a) {
-  switch (a) {
-    case Algorithm::Pathtrace: return false;
-    case Algorithm::Raymarch:
-    case Algorithm::Lobe: return true;
-  }
+#define ALGORITHM_REALTIME(cxx, name, realtime) \
+  case Algorithm::cxx: return realtime;
+  switch (a) { ALGORITHMS(ALGORITHM_REALTIME) }
+#undef ALGORITHM_REALTIME
   throw std::logic_error("isRealtime: not an Algorithm");
 }
 

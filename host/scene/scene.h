@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "image/display_transform.h"
+#include "shared/grid_storage_kinds.h"
 #include "shared/light_kinds.h"
 #include "shared/phase_kinds.h"
 
@@ -87,8 +88,10 @@ struct Camera {
 // take memory: grids beyond one image or buffer). Auto: the buffer on CPU devices (faster than
 // PoCL's image sampler) and on devices without image support, the image elsewhere (GPUs filter in
 // hardware); timings in bench/RESULTS.md. Bricks, with a warning, when that choice cannot hold the
-// grid. render/device_grid.h resolves it.
-enum class GridStorage { Auto, Image, Buffer, Bricks };
+// grid. render/device_grid.h resolves it. The kinds: kernels/shared/grid_storage_kinds.h.
+#define GRID_STORAGE_ENUMERATOR(name, cxx, define) cxx,
+enum class GridStorage { Auto, GRID_STORAGE_KINDS(GRID_STORAGE_ENUMERATOR) };
+#undef GRID_STORAGE_ENUMERATOR
 
 // What the ray marcher adds for light scattered more than once: nothing, Wrenninge's octaves, or
 // the path-traced multiple-scattering cache (kernels/shared/ms_cache.h).
@@ -182,8 +185,17 @@ struct PathtraceSettings {
 enum class LobeVariant { Eq7, Corrected };
 
 // What renders the scene (renderer.algorithm): the unbiased path tracer, or one of the real-time
-// kernels (the ray marcher, the dissertation's Lobe Estimator).
-enum class Algorithm { Pathtrace, Raymarch, Lobe };
+// kernels (the ray marcher, the dissertation's Lobe Estimator), one line each. Columns: the
+// enumerator, the name (the scene key's value, the names in outputs, and a real-time algorithm's
+// kernel: kernels/NAME.cl's `NAME`), whether it renders frames (one launch a frame, no samples to
+// accumulate: render/realtime_renderer.h) rather than samples.
+#define ALGORITHMS(X)                  \
+  X(Pathtrace, "pathtrace", false)      \
+  X(Raymarch, "raymarch", true)         \
+  X(Lobe, "lobe", true)
+#define ALGORITHM_ENUMERATOR(cxx, name, realtime) cxx,
+enum class Algorithm { ALGORITHMS(ALGORITHM_ENUMERATOR) };
+#undef ALGORITHM_ENUMERATOR
 // "pathtrace", "raymarch", "lobe": the scene key's values and the names in outputs.
 const char* algorithmName(Algorithm a);
 // Raymarch and Lobe: one launch a frame, no samples to accumulate.
