@@ -83,7 +83,7 @@ static inline vec3 light_cache_optical_depth(KERNEL_CONTEXT_PARAM, NV_PRIVATE co
   NV_CONSTANT const light_params* lights = ctx->lights;
   NV_CONSTANT const medium_params* m = ctx->medium;
   NV_PRIVATE uint* status = &ctx->status;
-  const vec3 sigma_t_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+  const vec3 sigma_t_unit = medium_sigma_t(m);
   if (lc->nx > 0)
     return vec3_scale(sigma_t_unit, light_cache_column(m, lc, cache, light, x, dir, dist, status));
   if (mp->shadow_area_samples > 1 && light_has_area(&lights[light])) /* the columns the cache would hold */

@@ -94,7 +94,7 @@ static inline float light_rectangle_column_phase(KERNEL_CONTEXT_PARAM, NV_CONSTA
   NV_CONSTANT const medium_params* m = ctx->medium;
   const vec3 nrm = vec3_from4(l->normal);
   const float area = l->normal.w, n = (float)(K * K);
-  const float sigma = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  const float sigma = vec3_average(medium_sigma_t(m));
   float w_sum = 0.0f, loss_sum = 0.0f, column_sum = 0.0f; /* as march_light_column */
   for (int strategy = 0; strategy < 2; ++strategy)
     for (int j = 0; j < K; ++j)
@@ -144,7 +144,7 @@ static inline float light_rectangle_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT con
     default: return 0.0f; /* unknown: reported at the kernel's entry */
   }
   const vec3 n = vec3_from4(l->normal);
-  const float sigma = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  const float sigma = vec3_average(medium_sigma_t(m));
   float w_sum = 0.0f, loss_sum = 0.0f, column_sum = 0.0f; /* loss: Σ w (e^{−σ̄C} − 1), no cancellation */
   for (int j = 0; j < K; ++j)
     for (int i = 0; i < K; ++i) {

@@ -185,7 +185,7 @@ static inline vec3 lobe_radiance_eq7(KERNEL_CONTEXT_PARAM, NV_PRIVATE const marc
   const vec3 x0 = vec3_madd(origin, dir, t_x0);
 
   /* 2. Lobe centre, depth clamped to the rest of the segment inside the box. */
-  const float mean_sigma_t = vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  const float mean_sigma_t = vec3_average(medium_sigma_t(m));
   const float rest = seg->t1 - t_x0;
   const float depth = lp->depth_factor < mean_sigma_t * rest ? lp->depth_factor / mean_sigma_t : rest;
   const vec3 c = vec3_madd(x0, dir, depth);
@@ -269,7 +269,7 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_PRIVATE cons
   /* C3-C4. Lobe points at r = lobe_radius mean free paths of unit density, each pulled in to the
    * box's boundary along its own direction (no intersection needed when the whole ball of radius r
    * about c is inside: lobe_ball_inside, a box intersection per point saved: bench/RESULTS.md). */
-  const float r = lp->radius / vec3_average(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)));
+  const float r = lp->radius / vec3_average(medium_sigma_t(m));
   const int n = lp->points;
   const int ball_inside = lobe_ball_inside(m, c, r);
   vec3 in_sum = vec3_splat(0.0f);

@@ -26,7 +26,7 @@ static inline vec3 march_emission(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_
                                   int steps, float t_stop) {
   NV_CONSTANT const medium_params* m = ctx->medium;
   NV_PRIVATE uint* status = &ctx->status;
-  const vec3 st_unit = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+  const vec3 st_unit = medium_sigma_t(m);
   march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, steps);
   vec3 L = vec3_splat(0.0f), T = vec3_splat(1.0f);
   float t;

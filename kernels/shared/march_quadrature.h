@@ -14,7 +14,7 @@ static inline vec3 march_sigma_t(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_s
                                  float t) {
   NV_CONSTANT const medium_params* m = ctx->medium;
   const float rho = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t));
-  return vec3_scale(vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s)), rho);
+  return vec3_scale(medium_sigma_t(m), rho);
 }
 
 /* Below this optical depth per step, (1 − e^{−x})/x is evaluated by its Taylor series: the direct

@@ -7,6 +7,11 @@
 
 #include "shared/intersect.h"
 
+/* σt = σa + σs per unit density, per channel: the medium's extinction before the density. */
+static inline vec3 medium_sigma_t(NV_CONSTANT const medium_params* m) {
+  return vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+}
+
 typedef struct medium_segment {
   vec3 o, d;      /* index-space origin and direction */
   float t0, t1;   /* world-parameter interval inside the box, clipped to [t_min, t_max] */

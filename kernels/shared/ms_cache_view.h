@@ -71,7 +71,7 @@ static inline ray3 ms_view_column_ray(NV_CONSTANT const camera_params* cam, int 
 
 /* Grey extinction per unit density: the mean of the channels (the march's τ and the nodes' agree). */
 static inline float ms_view_sigma_t(NV_CONSTANT const medium_params* m) {
-  const vec3 st = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+  const vec3 st = medium_sigma_t(m);
   return (st.x + st.y + st.z) / 3.0f;
 }
 

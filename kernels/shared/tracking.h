@@ -139,7 +139,7 @@ static inline tracking_walk tracking_walk_begin(NV_CONSTANT const medium_params*
   w.t = t0;
   w.grid = use_grid;
   if (use_grid) {
-    const vec3 st = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+    const vec3 st = medium_sigma_t(m);
     w.bar_scale = nv_fmax(st.x, nv_fmax(st.y, st.z)) * MAJORANT_MARGIN;
     w.dda = majorant_iter_begin(m->majorant_grid, o, d, t0, t1);
     w.seg_end = t0; /* no segment yet: the first step fetches one */
@@ -285,7 +285,7 @@ static inline vec3 tracking_ratio(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t,
     return vec3_splat(0.0f);
   }
   if (!(m->majorant > 0.0f)) return tr;
-  const vec3 st = vec3_add(vec3_from4(m->sigma_a), vec3_from4(m->sigma_s));
+  const vec3 st = medium_sigma_t(m);
   /* A homogeneous medium has the closed form: Beer-Lambert, no variance. */
   if (GRID_IS_HOMOGENEOUS_CTX(ctx)) return vec3_exp_neg(vec3_scale(st, nv_fmax(0.0f, t_max - t)));
   const vec3 entry = tracking_entry(o, d, t);
