@@ -41,8 +41,6 @@ bool gridFitsBuffer(const DeviceInfo& device, const DenseGrid& grid, std::string
 // the grid exceeds its 3D image size or largest allocation; the message names renderer.storage
 // "buffer" when one buffer would hold the grid, else "bricks".
 cl::Image3D uploadGridImage(ClRuntime& rt, const DenseGrid& grid);
-// The image storage's historical name.
-inline cl::Image3D uploadGrid(ClRuntime& rt, const DenseGrid& grid) { return uploadGridImage(rt, grid); }
 
 // A read-only buffer: GRID_BUFFER_HEADER ints (nx, ny, nz, 0), then the voxels. Throws InputError
 // naming the bytes asked for and the device's CL_DEVICE_MAX_MEM_ALLOC_SIZE when they exceed it; a
