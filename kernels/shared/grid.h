@@ -1,41 +1,28 @@
-/* grid.h: how a grid is stored and read, grid_value(g, p) (the kernels read density through
- * kernel_context.h's grid_density(ctx, p)), with p in grid index space (voxel i covers [i, i+1],
- * centre i + 0.5; trilinear; 0 outside). Storage is chosen here and nowhere else; the kernels'
- * arguments are the same for every choice (GRID_STORAGE is the type of a grid argument):
- * - device, -D MEDIUM_HOMOGENEOUS: 1 everywhere (the grid argument is an unused int);
- * - device, -D GRID_STORAGE_BUFFER: a __global float buffer (GRID_BUFFER_HEADER, then the voxels,
- *   x fastest) filtered by grid_trilinear below: the code the host runs;
- * - device, -D GRID_STORAGE_BRICKS: a __global float buffer holding sparse 8³ bricks with a
- *   one-voxel apron (grids beyond one image or buffer), filtered by grid_bricks_trilinear: the same
- *   corners and arithmetic as grid_trilinear, so the same bits;
- * - device, otherwise: a 3D image (CL_R, CL_FLOAT) read with the sampler (hardware filtering);
- * - host: grid_trilinear on a float array, so tests and a native baseline see the same field.
- * The host picks the storage per device (render/device_grid.h, scene key renderer.storage).
- * The kernel context (kernel_context.h) also carries the majorant grid's per-cell bounds
- * (GRID_MAJORANTS), so every function that reads density can skip empty space (march.h).
- *
- * Image and buffer reconstruct the same field; they differ in arithmetic only:
- * - Addressing: the sampler is CLK_ADDRESS_CLAMP (border colour 0: density outside the grid is 0,
- *   so the field fades to 0 over the half voxel outside the outermost voxel centres), not
- *   CLK_ADDRESS_CLAMP_TO_EDGE (which would repeat the edge voxels outwards). grid_trilinear reads 0
- *   for every corner outside the grid in the same way.
- * - Filtering: CLK_FILTER_LINEAR with unnormalised coordinates takes texel centres at i + 0.5:
- *   u = p - 0.5, i0 = floor(u), a = u - i0, and sums the eight corners as
- *   (1-a)(1-b)(1-c)·T000 + a(1-b)(1-c)·T100 + ... (the OpenCL spec's form, which PoCL computes in
- *   float). grid_trilinear computes the same a, b, c and nests three lerps instead. Both are sums
- *   of non-negative terms, so each is within a few float roundings of the exact value relative to
- *   the result: on PoCL image and buffer agree within 16 ε of the density, ε = 2^-24
- *   (tests/device/grid_storage_lookup_test.cpp; the gap measured: bench/RESULTS.md), and the
- *   buffer on the device matches the host bit for bit. Rendered pixels: tests/render/grid_storage_test.cpp.
- * - Many GPUs (NVIDIA among them; CUDA's texture units store a, b, c in 9-bit fixed point with 8
- *   fractional bits) quantise the weights to multiples of 1/256: a lookup may then be off by up to
- *   1/256 of the difference between neighbouring voxels along each axis, 3/256 of the eight
- *   corners' range in all (an H100's error: bench/RESULTS.md). The buffer is exact float
- *   arithmetic on every device (bit for bit the host's, on PoCL and on an H100); the image is
- *   still the right choice on GPUs, where it does more lookups per second (bench/RESULTS.md).
- * - The coordinate is clamped to [-1, 1e7] first: clamp addressing sends huge or infinite
- *   coordinates to the wrong edge on some devices (DESIGN.md), and here it keeps the int
- *   conversions defined. -1 is outside the grid by more than half a voxel: density 0. */
+/* grid.h: grid storage and lookup, grid_value(g, p) (kernels read density through kernel_context.h's
+ * grid_density) at p in grid index space: voxel i covers [i, i+1], centre i + 0.5; trilinear; 0
+ * outside. Storage is chosen here alone, with the same kernel arguments for each (GRID_STORAGE is a
+ * grid argument's type); the host picks it per device (render/device_grid.h, scene key renderer.storage).
+ * Device: -D MEDIUM_HOMOGENEOUS, 1 everywhere (an unused int); -D GRID_STORAGE_BUFFER, a __global float
+ * buffer (GRID_BUFFER_HEADER, then the voxels, x fastest) filtered by grid_trilinear, the host's code;
+ * -D GRID_STORAGE_BRICKS, sparse 8³ bricks (below) for grids beyond one image or buffer, the same bits;
+ * otherwise a 3D image (CL_R, CL_FLOAT) with the sampler's hardware filtering. Host: grid_trilinear on
+ * a float array, so tests and a native baseline see the same field.
+ * Image and buffer reconstruct the same field and differ in arithmetic only:
+ * - Addressing: CLK_ADDRESS_CLAMP (border 0), like grid_trilinear's zero corners, fades the field to 0
+ *   over the half voxel beyond the outer centres (CLK_ADDRESS_CLAMP_TO_EDGE would repeat edge voxels).
+ * - Filtering: CLK_FILTER_LINEAR (unnormalised) takes u = p - 0.5, i0 = floor(u), a = u - i0 and sums
+ *   (1-a)(1-b)(1-c)·T000 + a(1-b)(1-c)·T100 + ... (the OpenCL spec's form, float on PoCL);
+ *   grid_trilinear nests three lerps on the same a, b, c. Both sum non-negative terms, a few roundings
+ *   from exact: on PoCL they agree within 16 ε of the density, ε = 2^-24
+ *   (tests/device/grid_storage_lookup_test.cpp; bench/RESULTS.md); the device buffer is the host's
+ *   bits (pixels: tests/render/grid_storage_test.cpp).
+ * - Many GPUs (NVIDIA's texture units: 9-bit fixed point, 8 fractional bits) quantise a, b, c to
+ *   multiples of 1/256: up to 1/256 of the neighbour difference per axis, 3/256 of the eight corners'
+ *   range in all (bench/RESULTS.md). The buffer is exact float on every device; the image still does
+ *   more lookups per second on GPUs (bench/RESULTS.md).
+ * - Coordinates are clamped to [-1, 1e7] first: clamp addressing sends huge or infinite ones to the
+ *   wrong edge on some devices (DESIGN.md), and int conversions stay defined; -1 is over half a voxel
+ *   outside: density 0. */
 #ifndef NARVAL_GRID_H
 #define NARVAL_GRID_H
 
@@ -45,17 +32,14 @@
  * so the voxels stay 16-byte aligned), then nx·ny·nz floats, x fastest (the 3D image's order). */
 #define GRID_BUFFER_HEADER 4
 
-/* The weight of a corner at index i along an axis of n voxels: w inside the grid, 0 outside
- * (border colour 0). */
+/* A corner's weight at index i along an axis of n voxels: w inside, 0 outside (border colour 0). */
 static inline float grid_corner_weight(int i, int n, float w) { return (i >= 0 && i < n) ? w : 0.0f; }
 
-/* i clamped into [0, n-1]: corners outside the grid read an in-range voxel with weight 0, so all
- * eight loads are in bounds without a branch per corner. */
+/* i clamped into [0, n-1]: outside corners (weight 0) load an in-range voxel, with no branch per corner. */
 static inline int grid_clamp_index(int i, int n) { return i < 0 ? 0 : (i >= n ? n - 1 : i); }
 
-/* The eight corner values v_xyz (v100: x + 1, y, z) weighed along x, then y, then z: value · weight,
- * in the order the host's reference always used. Every storage that filters by hand (buffer,
- * bricks) ends here, so the same corners and weights give the same bits. */
+/* The eight corners v_xyz (v100: x + 1, y, z) weighed along x, then y, then z. Every storage that
+ * filters by hand (buffer, bricks) ends here, so the same corners and weights give the same bits. */
 static inline float grid_trilinear_combine(float v000, float v100, float v010, float v110, float v001, float v101,
                                            float v011, float v111, float wx0, float wx1, float wy0, float wy1,
                                            float wz0, float wz1) {
@@ -68,11 +52,9 @@ static inline float grid_trilinear_combine(float v000, float v100, float v010, f
   return c0 * wz0 + c1 * wz1;
 }
 
-/* Trilinear reconstruction of the dense grid `data` (nx·ny·nz floats, x fastest, all finite,
- * nx·ny < 2^31) at
- * index-space point p, with voxel centres at i + 0.5 and 0 outside the grid (see the notes above).
- * Inside [0.5, n - 0.5] on every axis it reproduces a field linear in x, y and z exactly (up to
- * float rounding); NaN coordinates read 0. */
+/* Trilinear value of the dense grid `data` (nx·ny·nz floats, x fastest, all finite, nx·ny < 2^31)
+ * at index-space point p (notes above). Inside [0.5, n - 0.5] on every axis it reproduces a field
+ * linear in x, y and z (to rounding); NaN coordinates read 0. */
 static inline float grid_trilinear(NV_GLOBAL const float* data, int nx, int ny, int nz, vec3 p) {
   const float fx = nv_fmin(nv_fmax(p.x, -1.0f), 1.0e7f) - 0.5f;
   const float fy = nv_fmin(nv_fmax(p.y, -1.0f), 1.0e7f) - 0.5f;
@@ -81,10 +63,9 @@ static inline float grid_trilinear(NV_GLOBAL const float* data, int nx, int ny, 
   const int x0 = (int)x0f, y0 = (int)y0f, z0 = (int)z0f;
   const float ax = fx - x0f, ay = fy - y0f, az = fz - z0f;
   if (x0 >= 0 && y0 >= 0 && z0 >= 0 && x0 < nx - 1 && y0 < ny - 1 && z0 < nz - 1) {
-    /* All eight corners inside (almost every lookup): one base address and fixed strides, the
-     * same products and sums as below (weights 1 - a and a), so the same bits. The slice stride
-     * nx·ny fits an int (the host refuses larger slices); the base is size_t for big grids.
-     * Why: more lookups per second than the general path alone (bench/RESULTS.md). */
+    /* All eight corners inside (almost every lookup): one base address, fixed strides, the same
+     * products and sums as below, so the same bits, and faster (bench/RESULTS.md). nx·ny fits an
+     * int (the host refuses larger slices); the base is size_t for big grids. */
     const int sy = nx, sz = nx * ny;
     NV_GLOBAL const float* b = data + ((size_t)x0 + (size_t)sy * (size_t)y0 + (size_t)sz * (size_t)z0);
     return grid_trilinear_combine(b[0], b[1], b[sy], b[sy + 1], b[sz], b[sz + 1], b[sz + sy], b[sz + sy + 1],
@@ -103,24 +84,16 @@ static inline float grid_trilinear(NV_GLOBAL const float* data, int nx, int ny, 
                                 wx0, wx1, wy0, wy1, wz0, wz1);
 }
 
-/* Sparse bricks (-D GRID_STORAGE_BRICKS: grids beyond one image or buffer).
- * The grid is cut into bricks of GRID_BRICK³ voxels, brick (bx, by, bz) owning voxels
- * [8bx, 8bx + 7] × ... A brick stores GRID_BRICK_STORED³ = 9³ values: its own voxels and a
- * one-voxel apron on the + side of each axis (voxels 8bx + 8, the first layer of the next brick;
- * 0 beyond the grid), x fastest. A lookup's corners are the clamped voxels xa = clamp(x0),
- * xb = clamp(x0 + 1) (as in grid_trilinear), and xb <= xa + 1 <= 8·(xa >> 3) + 8: all eight lie in
- * brick (xa >> 3, ya >> 3, za >> 3), so a lookup reads one index and one brick (the apron buys
- * that for 9³/8³ = 1.42x the voxels of the occupied bricks; without it a lookup near a brick face
- * would follow up to eight indices).
- * The index table holds per brick (x fastest) its slot in the pool, or GRID_BRICK_EMPTY when all
- * 9³ values it would store are exactly 0: every lookup that lands there reads eight zeros, which
- * grid_trilinear_combine turns into +0, the value returned without touching the pool.
- * Corners and weights are grid_trilinear's, summed by the same grid_trilinear_combine: bricks and
- * buffer give the same bits at every point (tests/unit/brick_grid_test.cpp on the host,
- * tests/device/grid_storage_lookup_test.cpp on the device).
- * Device layout, one buffer (the kernel signatures stay those of every storage):
- * GRID_BRICKS_HEADER 32-bit slots (nx, ny, nz as ints, then the pool's offset in floats from the
- * buffer's start), the table (one uint per brick), padding to 16 bytes, then the pool (9³ floats per
+/* Sparse bricks (-D GRID_STORAGE_BRICKS). Brick (bx, by, bz) owns voxels [8bx, 8bx + 7] × ... and
+ * stores GRID_BRICK_STORED³ = 9³ values, x fastest: its own and a one-voxel apron on each + side (the
+ * next brick's first layer; 0 beyond the grid). A lookup's corners xa = clamp(x0), xb = clamp(x0 + 1)
+ * satisfy xb <= xa + 1 <= 8·(xa >> 3) + 8, so all eight lie in brick (xa >> 3, ya >> 3, za >> 3): one
+ * index and one brick per lookup, for 9³/8³ = 1.42x the voxels (without the apron, up to eight indices).
+ * The table holds per brick (x fastest) its pool slot, or GRID_BRICK_EMPTY when all 9³ values are 0:
+ * eight zero corners give +0, returned without touching the pool. grid_trilinear's corners, weights and
+ * combine give the same bits (tests/unit/brick_grid_test.cpp, tests/device/grid_storage_lookup_test.cpp).
+ * Device layout, one buffer: GRID_BRICKS_HEADER 32-bit slots (nx, ny, nz as ints, then the pool's
+ * offset in floats), the table (one uint per brick), padding to 16 bytes, the pool (9³ floats per
  * occupied brick). Built by host/volume/brick_grid.h. */
 #define GRID_BRICKS_HEADER 4
 #define GRID_BRICK_LOG2 3

@@ -1,39 +1,25 @@
-/* light_cache.h: the light-transmittance cache of the real-time kernels (DESIGN.md "Real-time
- * caches"; the per-light "shadow volume" production engines keep, e.g. Hillaire 2016, Frostbite's
- * volumetric shadow maps). Per light, a grid of nodes over the medium's box holding what every
- * shadow ray of raymarch.h and lobe.h would otherwise march: the column density from the node to
- * the light (march_light_column: a point light; a rectangle's centre, or with shadow_area_samples
- * K > 1 its effective column over K×K points of its area).
- *
- * Layout: a node grid over the medium's box (node_grid.h; the light_cache kernel argument), one slab
- * of nodes per light, the slabs one after the other.
- *
- * What a node stores: C = Σ_k ρ(x_k)·Δ, march_column_density from the node towards the light with
- * the kernel's own shadow_steps (the same quadrature as the exact march: the cache changes where
- * the integral is evaluated, not how). One float serves every channel: σt(x) = σt_unit·ρ(x) with a
- * single σt_unit per medium (DESIGN.md physics), so τ = σt_unit·C; storing τ rather than e^{−τ}
- * also keeps the ray marcher's octaves exact (they need exp(−bⁱτ)) and interpolates the smooth
- * quantity: e^{−τ} of an interpolated τ never leaves [0, 1]. For a rectangle with
- * shadow_area_samples K > 1 the node holds the effective column over K×K points of the light
- * (march_light_column), and the exact march without the cache computes the same.
- *
- * Lookup: trilinear over the 8 nodes around the point (node_grid.h, which states the bounds of
- * that interpolation). For a homogeneous medium of density 1, C is the length of the part of the
- * shadow ray inside the box: smooth for a light outside (over the face it exits by), 1-Lipschitz
- * with a kink for a light inside (C = |x − light|); tests/unit/light_cache_test.cpp checks both.
- * Cost: one lookup (8 loads) replaces shadow_steps density lookups and a DDA walk per shadow ray.
- *
- * Built once per light on the device (kernels/light_cache.cl, host/render/device_light_cache.h), rebuilt
- * only when the medium, that light or the shadow step count changes. */
+/* light_cache.h: the real-time kernels' light-transmittance cache (DESIGN.md "Real-time caches"; the
+ * per-light "shadow volume" production engines keep, e.g. Hillaire 2016, Frostbite's volumetric shadow
+ * maps): what every shadow ray of raymarch.h and lobe.h would march, per node of a grid over the
+ * medium's box (node_grid.h; the light_cache kernel argument), one slab of nodes per light in turn.
+ * A node holds the column C = Σ_k ρ(x_k)·Δ to the light by march_light_column with the kernel's own
+ * shadow_steps, as the exact march computes it: the cache changes where the integral is evaluated, not
+ * how. One float serves every channel, τ = σt_unit·C (one σt_unit per medium: DESIGN.md physics);
+ * τ rather than e^{−τ} keeps the ray marcher's octaves exact (exp(−bⁱτ)) and interpolates the smooth
+ * quantity, whose e^{−τ} never leaves [0, 1]. Lookup: trilinear over the 8 surrounding nodes
+ * (node_grid.h states its bounds). In a homogeneous medium of density 1, C is the shadow ray's length
+ * inside the box: smooth for a light outside (over the face it exits by), 1-Lipschitz with a kink for
+ * one inside (C = |x − light|; tests/unit/light_cache_test.cpp checks both). One lookup (8 loads)
+ * replaces shadow_steps density lookups and a DDA walk per shadow ray. Built once per light on the
+ * device (kernels/light_cache.cl, host/render/device_light_cache.h); rebuilt only when the medium, that
+ * light or shadow_steps changes. */
 #ifndef NARVAL_LIGHT_CACHE_H
 #define NARVAL_LIGHT_CACHE_H
 
 #include "shared/march.h"
 #include "shared/node_grid.h"
 
-/* What node `node` of light l's slab holds: the column density from the node to the light over
- * the kernel's shadow quadrature (march_light_column: with K > 1 a rectangle's effective column
- * over its K×K points); 0 when the light sits on the node (nothing lies between).
+/* What node `node` of light l's slab holds (march_light_column); 0 when the light sits on the node.
  * Status word: STATUS_NAN for a NaN node point or column; STATUS_ITERATION_CAP from a DDA walk. */
 static inline float light_cache_build_node(KERNEL_CONTEXT_PARAM,
                                            NV_PRIVATE const node_grid_params* c, int shadow_steps, int K,
@@ -50,17 +36,15 @@ static inline float light_cache_build_node(KERNEL_CONTEXT_PARAM,
   return column;
 }
 
-/* Column density to light `light` at index-space point p inside the box [0, dims]: trilinear over
- * the slab's nodes. */
+/* Column density to light `light` at index-space point p in the box [0, dims]: trilinear over its slab. */
 static inline float light_cache_column_at(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache,
                                           int light, vec3 dims, vec3 p) {
   return node_grid_interpolate(c, cache + (size_t)light * (size_t)node_grid_count(c), 1, node_grid_locate(c, dims, p));
 }
 
-/* Column density from world point x to light `light`, which lies `dist` away along unit `dir`.
- * The density is 0 outside the box, so the shadow ray's column is that of the point where it
- * enters the box (x itself when x is inside): a point outside reads the box's face, never an
- * extrapolation, and a shadow ray that misses the box has column 0. */
+/* Column density from world point x to light `light`, `dist` away along unit `dir`. Density is 0
+ * outside the box, so the column is that of the point where the shadow ray enters it (x when inside):
+ * a point outside reads the box's face, never an extrapolation; a ray missing the box has column 0. */
 static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_PRIVATE const node_grid_params* c,
                                        NV_GLOBAL const float* cache, int light, vec3 x, vec3 dir, float dist,
                                        NV_PRIVATE uint* status) {
@@ -73,10 +57,9 @@ static inline float light_cache_column(NV_CONSTANT const medium_params* m, NV_PR
   return light_cache_column_at(c, cache, light, dims, vec3_madd(seg.o, seg.d, seg.t0));
 }
 
-/* Optical depth τ from x to light `light` (unit `dir`, `dist` from light_view_from), per
- * channel: one cache lookup when the cache is on, else the exact shadow march of shadow_steps
- * samples (the kernels' pixels before the cache, bit for bit). Both real-time kernels call this
- * for every shadow ray. */
+/* Optical depth τ per channel from x to light `light` (unit `dir`, `dist` from light_view_from), for
+ * every shadow ray of both real-time kernels: one cache lookup when the cache is on, else the exact
+ * shadow march of shadow_steps samples. */
 static inline vec3 light_cache_optical_depth(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
                                              NV_PRIVATE const node_grid_params* lc, NV_GLOBAL const float* cache,
                                              int light, vec3 x, vec3 dir, float dist, vec3 view_dir) {

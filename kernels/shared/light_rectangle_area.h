@@ -1,7 +1,5 @@
-/* light_rectangle_area.h: what the real-time kernels do with a rectangle light's area
- * (light_kinds.h's area column; march.h dispatches here): the phase function summed over K×K points
- * of it or integrated over its solid angle exactly (phase_polygon.h), and its shadow averaged over
- * those points, weighted by their share of the light or by the phase towards the camera. */
+/* light_rectangle_area.h: a rectangle light's area in the real-time kernels (light_kinds.h's area
+ * column; march.h dispatches here): its phase over K×K points or exact, its shadow over K×K points. */
 #ifndef NARVAL_LIGHT_RECTANGLE_AREA_H
 #define NARVAL_LIGHT_RECTANGLE_AREA_H
 
@@ -17,16 +15,13 @@ static inline vec3 light_rectangle_area_point(NV_CONSTANT const light_params* l,
                                                   vec3_scale(vec3_from4(l->edge_v), ((float)j + 0.5f) * inv_k)));
 }
 
-/* Light l's unshadowed in-scattering at x per unit σs, Σ_j I_j·p(g, view_dir·dir_j)/d_j² (view_dir
- * the propagation direction before scattering, e.g. away from the camera): a point light is itself;
- * a rectangle is K×K points at the centres of a K×K split of its area, each with intensity
- * Le·(A/K²)·max(0, cos θ_j) towards x (the midpoint rule over the area, as the path tracer's area
- * light integrates exactly). Why not the centre alone (K = 1, light_view_from): with a
- * forward-peaked phase function the phase angle changes across the light by more than the lobe's
- * width (HG(0.8) halves within 10°; a 6-unit light 20 units away spans 17°): the centre for both
- * phase and shadow loses much of the single scattering at g 0.8, and K×K points for the phase and
- * the shadow (march_light_column) recover most of it (bench/RESULTS.md, "Rectangle lights as K×K
- * points"). */
+/* Light l's unshadowed in-scattering at x per unit σs over K×K points at the centres of a K×K split
+ * of its area, Σ_j I_j·p(view_dir·dir_j)/d_j², I_j = Le·(A/K²)·max(0, cos θ_j), view_dir the
+ * propagation before scattering (the midpoint rule; the path tracer integrates exactly). Why not the
+ * centre alone (K = 1): across the light the phase angle changes by more than a forward lobe's width
+ * (HG(0.8) halves within 10°; a 6-unit light 20 units away spans 17°); K×K points for phase and shadow
+ * (march_light_column) recover most of the single scattering the centre loses (bench/RESULTS.md,
+ * "Rectangle lights as K×K points"). */
 static inline vec3 light_rectangle_phase_sum(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                          vec3 view_dir, int K) {
   const vec3 Le = vec3_from4(l->radiance);
@@ -46,13 +41,11 @@ static inline vec3 light_rectangle_phase_sum(NV_CONSTANT const light_params* l, 
   return vec3_scale(Le, l->normal.w * inv_k * inv_k * sum);
 }
 
-/* Light l's unshadowed in-scattering at x per unit σs with the phase integrated exactly over a
- * rectangle's solid angle, Le·∫_rect p(view_dir·ω) dω (phase_polygon.h): the limit of
- * light_rectangle_phase_sum as K → ∞, for 16–64 evaluations of a closed form per rectangle whatever
- * its size. Why: at g 0.9 HG falls to half its peak within 5°, and Listing 4.1's light (150x100
- * units, 80 behind the Disney cloud) spans 86°x64° from it: its centre alone paints a bright disc
- * wherever the view ray points at it (the phase's peak) and misses the rest (the back-lit Disney
- * cloud with the multiple-scattering cache, bench/RESULTS.md); K×K points paint K² discs. */
+/* The same with the phase integrated exactly over the solid angle, Le·∫_rect p(view_dir·ω) dω
+ * (phase_polygon.h): the limit K → ∞, 16–64 closed-form evaluations per rectangle whatever its size.
+ * Why: at g 0.9 HG halves within 5° and Listing 4.1's light spans 86°x64° from the Disney cloud: its
+ * centre paints a bright disc where the view ray points at it and misses the rest, K×K points paint
+ * K² discs (bench/RESULTS.md: the back-lit Disney cloud with the multiple-scattering cache). */
 static inline vec3 light_rectangle_phase_integral(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                               vec3 view_dir) {
   const vec3 c = vec3_from4(l->corner), u = vec3_from4(l->edge_u), v = vec3_from4(l->edge_v);
@@ -64,9 +57,9 @@ static inline vec3 light_rectangle_phase_integral(NV_CONSTANT const light_params
 }
 
 /* The effective column of weighted shadow rays, −ln(Σ w e^{−σ̄C}/Σ w)/σ̄, from Σ w, Σ w·(e^{−σ̄C} − 1)
- * and Σ w·C: through expm1 and log1p, so a thin column keeps its digits. No extinction, or every ray
- * fully shadowed: the weighted mean column (the limit σ̄ → 0, and as dark as the float allows
- * otherwise). Nothing weighted (nothing of the light faces x, or x is the point light): 0. */
+ * and Σ w·C via expm1 and log1p, so a thin column keeps its digits. No extinction, or every ray fully
+ * shadowed: the weighted mean column (the limit σ̄ → 0; else as dark as float allows). Nothing
+ * weighted (nothing of the light faces x, or x is the point light): 0. */
 static inline float march_mean_column(float w_sum, float loss_sum, float column_sum, float sigma) {
   if (!(w_sum > 0.0f)) return 0.0f;
   const float mean_loss = loss_sum / w_sum;
@@ -75,20 +68,16 @@ static inline float march_mean_column(float w_sum, float loss_sum, float column_
 }
 
 /* A rectangle's effective column weighted by the phase towards the camera (SHADOW_WEIGHTING_PHASE):
- * T̄ = ∫ p(view_dir·ω) T(ω) dω / ∫ p(view_dir·ω) dω over the light's solid angle, so that
- * Le·T̄·∫ p dω (march_light_phase) is the single scattering ∫ Le p T dω whenever the phase and the
- * shadow vary together. They do behind a cloud lit from the back: at g 0.9 the phase is a peak a
- * few degrees wide around the view ray's continuation, the shadow along it is the thin rim's, and
- * an average over the light's area (the other weighting) takes in directions through the cloud's
- * body (bench/RESULTS.md: the back-lit Disney cloud's rim too dark, its core too bright). Both
- * integrals are estimated by two strategies combined with the balance heuristic (Veach 1997,
- * ch. 9): the K×K points of light_rectangle_area_point (the area's midpoint rule: a solid-angle pdf of
- * d²/(A·cos θ_l)), and K×K directions drawn from the phase function about view_dir on a regular
- * grid of its two numbers (pdf p), those that meet the light's front. The first serves broad
- * phases and lights far off the view direction, the second the peak, however narrow. A sample of
- * either is weighted by p/(n·pdf_area + n·p), n = K², in both the numerator (times T) and the
- * denominator, so the ratio is exact for a shadow constant over the light and converges as K grows.
- * Deterministic: fixed patterns, no random numbers. Returns −ln T̄/σ̄ as march_light_column. */
+ * T̄ = ∫ p(view_dir·ω) T(ω) dω / ∫ p dω over its solid angle, so Le·T̄·∫ p dω (march_light_phase) is the
+ * single scattering ∫ Le p T dω when phase and shadow vary together, as behind a back-lit cloud: at g 0.9
+ * the phase peaks within degrees of the view ray's continuation, shadowed by the thin rim, while the
+ * area average looks through the body (bench/RESULTS.md: the back-lit Disney cloud's rim too dark, core
+ * too bright). Both integrals combine by the balance heuristic (Veach 1997, ch. 9) K×K area points
+ * (light_rectangle_area_point, solid-angle pdf d²/(A·cos θ_l): broad phases, lights off the view) and
+ * K×K phase samples about view_dir on a regular grid (pdf p, those meeting the light's front: the peak,
+ * however narrow), each weighing p/(n·pdf_area + n·p), n = K², in numerator (times T) and denominator:
+ * exact for a shadow constant over the light, converging as K grows. Deterministic (fixed patterns).
+ * Returns −ln T̄/σ̄ as march_light_column. */
 static inline float light_rectangle_column_phase(KERNEL_CONTEXT_PARAM, NV_CONSTANT const light_params* l, vec3 x, int K,
                                              int shadow_steps, vec3 view_dir) {
   NV_CONSTANT const medium_params* m = ctx->medium;
@@ -126,14 +115,11 @@ static inline float light_rectangle_column_phase(KERNEL_CONTEXT_PARAM, NV_CONSTA
   return march_mean_column(w_sum, loss_sum, column_sum, sigma);
 }
 
-/* A rectangle's effective shadow column over its K×K points (march_light_phase_sum's):
- * C = −ln(Σ_j w_j e^{−σ̄ C_j} / Σ_j w_j) / σ̄, w_j = cos θ_j / d_j² (each point's share of the light
- * reaching x), σ̄ the medium's mean σt per unit density. Why: the path tracer's shadow rays go to
- * every point of the light, and the transmittance averaged over them is above the transmittance to
- * the centre (e^{−τ} is convex): through a dense cloud the centre alone makes the light's soft
- * shadow hard and dark. With one σt for all channels (a grey medium) σt_unit·C gives each channel's
- * averaged transmittance exactly; for a coloured one it is the average for the mean σt.
- * SHADOW_WEIGHTING_PHASE weights it by the phase for view_dir instead (light_rectangle_column_phase). */
+/* A rectangle's effective shadow column over its K×K points: C = −ln(Σ_j w_j e^{−σ̄ C_j}/Σ_j w_j)/σ̄,
+ * w_j = cos θ_j/d_j² (each point's share of the light reaching x), σ̄ the mean σt per unit density.
+ * Why: the path tracer's shadow rays go to every point of the light, and their mean transmittance
+ * exceeds the centre's (e^{−τ} is convex): the centre alone makes a soft shadow through a dense cloud
+ * hard and dark. σt_unit·C is exact per channel for a grey medium, the mean σt's for a coloured one. */
 static inline float light_rectangle_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const light_params* l,
                                        vec3 x, int K, int shadow_steps, int weighting, vec3 view_dir) {
   NV_CONSTANT const medium_params* m = ctx->medium;

@@ -1,103 +1,73 @@
-/* lobe.h: the Lobe Estimator (dissertation ch. 6, Eq. 7; DESIGN.md "lobe"), one deterministic
- * estimate per pixel:
- *
+/* lobe.h: the Lobe Estimator (dissertation ch. 6, Eq. 7; DESIGN.md "lobe"), deterministic, per pixel:
  *   L = L_b · (1/n) Σ_i Tr(x0 → P_i)
  *     + albedo ⊙ Σ_k (1/n) Σ_i p(cos θ_i) · Tr(P_i → light_k) · I_k / |light_k − P_i|²
  *
- * Parameters (march_params and lobe_params, structs.h; scene keys renderer.lobe.*):
- *   steps             samples of the first-hit search over the view ray's segment in the box
- *                     (firstHitSteps, default 60), then LOBE_BISECTIONS bisection steps
- *   shadow_steps      midpoint samples of each transmittance to a light (shadowSteps, default 100):
- *                     the exact march, or the quadrature the light cache's nodes were built with
- *   view_steps        midpoint samples of each Tr(x0 → P_i) (viewSteps)
- *   min_transmittance Tr(x0 → P_i) stops once below it in every channel (minTransmittance)
- *   depth_factor      lobe centre depth in mean free paths of unit density (default 20)
- *   radius            |P_i − c| in world units (default 1)
- *   points            n, the directions in `dirs` (default 30)
+ * Parameters: march_params and lobe_params (structs.h; keys renderer.lobe.* and defaults in
+ * docs/scene-format.md), each named below where it acts; n = points, the directions in `dirs`.
  *
- * 1. x0: the first point of the view ray inside the box where the density is above zero. The
- *    search takes `steps` midpoint samples over the occupied majorant cells only (march_iter) and
- *    bisects the step where the density first becomes positive; features thinner than a step
- *    between two samples can be missed.
- * 2. c = x0 + t·ω, t = depth_factor / σ̄t, σ̄t the mean over channels of (σa + σs) for unit density
- *    (D included). Clamp: t never exceeds the rest of the view ray's segment inside the box, so c
- *    stays "a point inside the volume" as ch. 6 describes it (the box is the medium's support; past
- *    it nothing attenuates and the lobe would sample unshadowed light). This also keeps σ̄t = 0 or
- *    tiny finite without dividing by it: t = depth_factor/σ̄t only when that is below the rest of
- *    the segment, tested as depth_factor < σ̄t·rest.
- * 3. d_i = the host's canonical directions (HG(g) about +Z, host/render/lobe_directions.cpp)
- *    rotated onto ω. P_i = c + r·d_i, exactly DESIGN.md. Sign check: the light that reaches c from
- *    P_i travels along c − P_i = −r·d_i, and leaves c towards the camera along −ω, so the phase
- *    angle at c has cos = dot(−d_i, −ω) = dot(d_i, ω), which is HG(g)-distributed: importance
- *    sampling of the phase lobe of light arriving at c and scattered to the camera. For g > 0 the
- *    d_i point along ω, i.e. the P_i lie beyond c as seen from the camera ("behind c"): forward
- *    scattering, light coming from behind the medium is bright (dissertation Fig. 2.10). DESIGN.md's
- *    two statements agree; the dissertation's GLSL flips this sign (a bug, not followed).
- *    The frame about ω is built from the camera's `right` vector (its component perpendicular to
- *    ω), not vec3_basis(ω): the lobe is then attached to the camera, so moving camera and scene
- *    rigidly together leaves the image unchanged, and the frame varies smoothly across the image
- *    (vec3_basis flips where ω.z changes sign, which would print a seam).
- * 4. Transmittances by the midpoint rule (true step lengths, all channels, only the part inside
- *    the box): Tr(x0 → P_i) over view_steps samples, Tr(P_i → light) by light_cache_optical_depth
- *    (one lookup in the light-transmittance cache, or the exact march of shadow_steps), lights as
- *    points (light_view_from: a rectangle is a point at its centre with intensity
- *    Le·A·max(0, cos θ_light), as DESIGN.md allows for real-time kernels).
- *    Shadow rays see only the medium, not other rectangles. cos θ_i = dot(normalize(P_i − light),
- *    −d_i): light propagating from the light to P_i, then from P_i towards c. albedo = σs/σt per
- *    channel (0 where σt = 0).
- * Economies: when L_b is exactly 0 the view transmittances are not marched (their term is 0·Tr = 0
- * either way: no pixel changes). Early termination of Tr(x0 → P_i) (min_transmittance ε > 0): the
- * march stops once every channel's partial τ exceeds −ln ε', ε' = ε / max(1, max channel of L_b),
- * so the value used is in [Tr_true, ε') and each of the n terms is off by less than ε':
- * |ΔL| < ε'·L_b ≤ ε per channel (raymarch.h says why ε is scaled by L_b).
- * No medium, a ray that misses the box (or meets a rectangle light first), or no density > 0 on the
- * segment: L = L_b exactly (march_view). Means divide by n (not multiply by 1/n), so n
- * transmittances of exactly 1 give exactly L_b.
+ * 1. x0: the view ray's first point in the box with density > 0: `steps` midpoint samples over the
+ *    occupied majorant cells only (march_iter), then LOBE_BISECTIONS bisections; features thinner than a
+ *    step can be missed.
+ * 2. c = x0 + t·ω, t = depth_factor / σ̄t, σ̄t the channel mean of σa + σs for unit density (D included),
+ *    clamped to the rest of the segment in the box so that c stays "a point inside the volume" (ch. 6):
+ *    past the box nothing attenuates and the lobe would see unshadowed light. Testing
+ *    depth_factor < σ̄t·rest never divides by a zero or tiny σ̄t.
+ * 3. d_i = the host's canonical directions (HG(g) about +Z, host/render/lobe_directions.cpp) rotated onto
+ *    ω; P_i = c + r·d_i, r = radius in world units, exactly DESIGN.md. Sign: light from P_i reaches c
+ *    along −d_i and leaves towards the camera along −ω, so cos = dot(d_i, ω) is HG(g)-distributed,
+ *    importance sampling c's phase lobe; for g > 0 the P_i lie beyond c, and light from behind the medium
+ *    is bright (forward scattering, dissertation Fig. 2.10). DESIGN.md's two statements agree; the
+ *    dissertation's GLSL flips this sign (a bug, not followed). The frame about ω comes from the camera's
+ *    `right` vector, not vec3_basis(ω): the lobe is attached to the camera (moving camera and scene
+ *    rigidly together leaves the image unchanged) and smooth across the image (vec3_basis flips with
+ *    ω.z's sign: a seam).
+ * 4. Transmittances by the midpoint rule (true step lengths, all channels, inside the box only):
+ *    Tr(x0 → P_i) over view_steps samples, Tr(P_i → light) by light_cache_optical_depth (a cache lookup
+ *    or the exact march of shadow_steps). Lights as in raymarch.h (march_light_sum: a rectangle is a
+ *    point at its centre, as DESIGN.md allows for real-time kernels); shadow rays see only the medium.
+ *    cos θ_i = dot(normalize(P_i − light), −d_i): from the light to P_i, then towards c. albedo = σs/σt
+ *    per channel (0 where σt = 0).
+ * Economies: with L_b exactly 0 the view transmittances are not marched (0·Tr = 0: no pixel changes).
+ * Early termination (min_transmittance ε > 0): Tr(x0 → P_i) stops once every channel's τ exceeds −ln ε',
+ * ε' = ε / max(1, max channel of L_b); the value used is in [Tr_true, ε'), so each of the n terms is off
+ * by less than ε': |ΔL| < ε'·L_b ≤ ε per channel (raymarch.h says why ε is scaled by L_b). No medium, a
+ * ray missing the box (or meeting a rectangle light first), or no density > 0 on the segment: L = L_b
+ * exactly (march_view). Means divide by n, so n transmittances of 1 give exactly L_b.
  * Loops: the first-hit search (`steps` samples, then LOBE_BISECTIONS), n lobe points × (one march of
  * view_steps + lights × (one cache lookup or a march of shadow_steps)): all bounded by the scene's
- * parameters; the only open-ended walk is the DDA under each march, capped by its budget
- * (majorant.h).
+ * parameters; the only open-ended walk is the DDA under each march, capped by its budget (majorant_dda.h).
  *
- * Corrected (renderer.lobe.variant "corrected"; "eq7", the default, is all of the above, bit for
- * bit). It keeps the idea (HG-distributed points about a point inside the medium past the view
- * ray's entry, their light averaged) and changes what the measurements showed wrong:
- * C1. Eq. 7's in-scattered term does not depend on how much the medium scatters: a wisp of
- *     density 1e-6 gets the same albedo·S̄ as a dense core (the white sheet around the smoke). The
- *     single-scattering integral along the view ray, with the in-scattered radiance S taken as
- *     constant along it, is ∫ σs(t) T(t) S dt = albedo·S·∫ σt(t) T(t) dt = albedo·S·(1 − T_v)
- *     (since d/dt T = −σt T and albedo = σs/σt is the same at every density), T_v the view ray's
- *     transmittance through the box. So the term is weighted by (1 − T_v): as the density → 0,
- *     T_v → 1 and L → L_b continuously. The background term becomes L_b·T_v, what reaches the
- *     camera unscattered (Eq. 7's mean Tr(x0 → P_i) counts light that the lobe points see, not the
- *     camera; dropping it also drops its n view marches). One march of view_steps samples over the
- *     occupied cells gives T_v.
- * C2. The centre: the same march gives where along the view ray the camera's light is scattered,
- *     t_c = ∫ t σt T S dt / ∫ σt T S dt (midpoint rule, channel means), S the lights' in-scattering
- *     at t (one light-cache lookup per sample); where no light reaches the ray, the expected depth
- *     of its first interaction, ∫ t σt T dt / ∫ σt T dt. Eq. 7's depth_factor/σ̄t measures depth
- *     with unit density, so in a thin wisp or a dense core c lands where nothing scatters (the
- *     black core and white ring on the default cloud); weighting by S as well matters where the
- *     light comes from behind (the back-lit Disney cloud, bench/RESULTS.md). t_c lies between the
- *     entry and the last sample with density (a weighted mean of sample positions), inside the box;
- *     first-hit search and depth_factor are not used. Early termination as in step 4: the march
- *     stops once every channel's τ exceeds −ln ε'; the samples left carry weight below ε' together,
- *     so 1 − T_v is off by less than ε' (relative error of the in-scattered term below ε'/(1 − ε')).
- * C3. Scale: lobe_radius is in mean free paths of unit density, r = lobe_radius/σ̄t. Scaling the
- *     geometry by s and σ by 1/s scales r, t_c and every segment by s and leaves every optical
- *     depth, T_v, phase angle and (for rectangle lights, I ∝ area) I/d² unchanged: the same image.
- *     Eq. 7's r in world units gives another picture at another scale.
- * C4. The lobe stays inside the medium: P_i = c + min(r, distance from c to the box along d_i)·d_i.
- *     A point outside the box sees its light unshadowed, which Eq. 7 paints as a bright ring
- *     around silhouettes.
+ * Corrected (renderer.lobe.variant "corrected"; "eq7", the default, is all of the above, bit for bit)
+ * keeps the idea (HG-distributed points about a point inside the medium past the view ray's entry, their
+ * light averaged) and changes what the measurements showed wrong:
+ * C1. Eq. 7's in-scattered term ignores how much the medium scatters (a wisp of density 1e-6 gets a dense
+ *     core's albedo·S̄: the white sheet around the smoke). With S constant along the view ray, single
+ *     scattering is ∫ σs T S dt = albedo·S·∫ σt T dt = albedo·S·(1 − T_v) (d/dt T = −σt T; albedo
+ *     independent of density), T_v the view ray's transmittance through the box: the term is weighted by
+ *     1 − T_v, and L → L_b continuously as the density → 0. The background term becomes L_b·T_v, the
+ *     light reaching the camera unscattered (Eq. 7's mean Tr(x0 → P_i) is what the lobe points see;
+ *     dropping it saves n view marches).
+ * C2. The centre: one march (view_steps samples, occupied cells) gives T_v and where the camera's light
+ *     is scattered, t_c = ∫ t σt T S dt / ∫ σt T S dt (midpoint rule, channel means; S the lights'
+ *     in-scattering, one light-cache lookup per sample), or with no light on the ray the expected first
+ *     interaction, ∫ t σt T dt / ∫ σt T dt; a weighted mean of sample positions, inside the box. Eq. 7's
+ *     depth_factor/σ̄t assumes unit density, so in a thin wisp or a dense core c lands where nothing
+ *     scatters (black core and white ring on the default cloud); weighting by S matters for back-lit
+ *     media (bench/RESULTS.md). Early termination as above: the samples left weigh below ε' together, so
+ *     1 − T_v is off by less than ε' (the in-scattered term by a relative ε'/(1 − ε')).
+ * C3. Scale: r = radius/σ̄t, radius in mean free paths of unit density. Scaling geometry by s and σ by
+ *     1/s scales r, t_c and every segment by s and leaves every optical depth, T_v, phase angle and
+ *     (rectangle lights, I ∝ area) I/d² unchanged: the same image, which Eq. 7's world-unit r breaks.
+ * C4. P_i = c + min(r, distance from c to the box along d_i)·d_i: a point outside the box sees its light
+ *     unshadowed, which Eq. 7 paints as a bright ring around silhouettes.
  * Result: L = L_b·T_v + (1 − T_v)·albedo ⊙ (1/n) Σ_i Σ_k p(cos θ_i) · Tr(P_i → light_k) · I_k / d².
  * Loops: one march of view_steps, n × lights lookups; no first-hit search, no view marches.
  *
  * Emission (-DEMISSION, emission.h): both variants add march_emission over the view ray's segment
  * (`steps` samples), the medium's own light, which neither estimate above holds.
  *
- * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density, phase value or
- * lobe point met on the way; STATUS_ITERATION_CAP from a DDA walk. No pdf: never
- * STATUS_NEGATIVE_PDF. */
+ * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density, phase value or lobe
+ * point met on the way; STATUS_ITERATION_CAP from a DDA walk; no pdf, so never STATUS_NEGATIVE_PDF. */
 #ifndef NARVAL_LOBE_H
 #define NARVAL_LOBE_H
 
@@ -108,9 +78,8 @@
 /* Halvings of the first-hit step: x0 is placed within Δ/64 past the density's zero crossing. */
 #define LOBE_BISECTIONS 6
 
-/* First parameter in [seg.t0, seg.t1] where the density is above zero; 0 when there is none. The
- * search samples the occupied cells only (march_iter), then bisects between the last empty sample
- * (or the start of the occupied piece) and the first non-empty one. */
+/* First parameter in [seg.t0, seg.t1] where the density is above zero (step 1; 0: none), bisected
+ * between the last empty sample (or the start of the occupied piece) and the first non-empty one. */
 static inline int lobe_first_hit(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg,
                                  int steps, NV_PRIVATE float* t_hit) {
   NV_PRIVATE uint* status = &ctx->status;
@@ -144,8 +113,7 @@ static inline int lobe_first_hit(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_s
   return 0;
 }
 
-/* Transmittance along the straight segment a → b (1 when they coincide), its march stopped once
- * its optical depth exceeds tau_limit in every channel (NV_INFINITY: never). */
+/* Transmittance along a → b (1 where they coincide), marched until every channel's τ exceeds tau_limit. */
 static inline vec3 lobe_transmittance_between(KERNEL_CONTEXT_PARAM, vec3 a, vec3 b,
                                               int steps, float tau_limit) {
   NV_PRIVATE uint* status = &ctx->status;
@@ -210,11 +178,9 @@ static inline vec3 lobe_radiance_eq7(KERNEL_CONTEXT_PARAM, NV_PRIVATE const marc
   return vec3_add(vec3_mul(Lb, tr_mean), vec3_mul(lobe_albedo(m), in_mean));
 }
 
-/* Whether every point within world distance r of c lies inside the medium's box (C4's pull-in then
- * leaves every lobe point where it is). Moving a point by r moves its index-space coordinate a by at
- * most r·|row a of world_to_index| (Cauchy-Schwarz), so the ball is inside when each coordinate of c
- * is that far from both faces; the bound is conservative (a ball near a face falls back to the
- * per-point intersection), so the pixels are those of the per-point test. */
+/* Whether the ball of world radius r about c lies inside the medium's box (C4 then moves no point).
+ * Moving a point by r moves index coordinate a by at most r·|row a of world_to_index| (Cauchy-Schwarz);
+ * conservative: a ball near a face falls back to the per-point test, so the pixels are that test's. */
 static inline int lobe_ball_inside(NV_CONSTANT const medium_params* m, vec3 c, float r) {
   const vec3 p = affine_point(m->world_to_index, c), dims = vec3_from4(m->dims);
   const float pc[3] = {p.x, p.y, p.z}, size[3] = {dims.x, dims.y, dims.z};
@@ -235,9 +201,8 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_PRIVATE cons
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
   NV_CONSTANT const medium_params* m = &s->medium;
-  /* C1-C2. One march of the view ray: its transmittance T_v and where its light is scattered,
-   * t_c = Σ w_k S_k t_k / Σ w_k S_k with w_k = T(before k)·(1 − e^{−σ̄t,k Δ}) (channel means) and
-   * S_k the lights' in-scattering at sample k (Σ w_k t_k / Σ w_k where no light reaches the ray). */
+  /* C1-C2. One march: T_v and t_c = Σ w_k S_k t_k / Σ w_k S_k, w_k = T(before k)·(1 − e^{−σ̄t,k Δ})
+   * (channel means), S_k the lights' in-scattering at sample k (Σ w_k t_k / Σ w_k where no light reaches). */
   const float tau_limit = mp->min_transmittance > 0.0f
                               ? -nv_log(mp->min_transmittance / nv_fmax(1.0f, vec3_max_component(Lb)))
                               : NV_INFINITY;
@@ -266,9 +231,7 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_PRIVATE cons
   const vec3 Tv = vec3_exp_neg(tau);
   const vec3 c = vec3_madd(origin, dir, ws_sum > 0.0f ? wst_sum / ws_sum : wt_sum / w_sum);
 
-  /* C3-C4. Lobe points at r = lobe_radius mean free paths of unit density, each pulled in to the
-   * box's boundary along its own direction (no intersection needed when the whole ball of radius r
-   * about c is inside: lobe_ball_inside, a box intersection per point saved: bench/RESULTS.md). */
+  /* C3-C4. Points pulled in to the box along d_i; no intersection when the ball is inside (bench/RESULTS.md). */
   const float r = lp->radius / vec3_average(medium_sigma_t(m));
   const int n = lp->points;
   const int ball_inside = lobe_ball_inside(m, c, r);
@@ -286,10 +249,8 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_PRIVATE cons
   return vec3_add(vec3_mul(Lb, Tv), vec3_mul(vec3_mul(opacity, lobe_albedo(m)), in_mean));
 }
 
-/* The lobe's frame (t, b, ω) about the unit view direction ω = `dir`: t is the camera's right
- * vector made perpendicular to ω (so the frame varies smoothly across the image, header comment),
- * b = ω × t. A direction along ±right has no such component (no camera ray is one, since every
- * camera ray leans forward, but a caller's may be): any perpendicular frame then serves. */
+/* The lobe's frame (t, b, ω) about unit ω = `dir` (step 3): t = `right` made perpendicular to ω, b = ω × t;
+ * along ±right (no camera ray, which leans forward, but a caller's may be) any perpendicular frame serves. */
 static inline void lobe_frame(vec3 dir, vec3 right, NV_PRIVATE vec3* tx, NV_PRIVATE vec3* ty) {
   const vec3 perp = vec3_madd(right, dir, -vec3_dot(right, dir));
   const float len = vec3_length(perp);
@@ -302,21 +263,20 @@ static inline void lobe_frame(vec3 dir, vec3 right, NV_PRIVATE vec3* tx, NV_PRIV
   *ty = vec3_cross(dir, *tx);
 }
 
-/* Radiance of the view ray from `origin` along unit `dir`. `right` is the camera's unit right
- * vector (the lobe frame's reference, see the header comment); `dirs` holds lp->points unit
- * directions about +Z. */
+/* Radiance of the view ray from `origin` along unit `dir`; `right`: the camera's unit right vector
+ * (lobe_frame); `dirs`: lp->points unit directions about +Z. */
 static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
                                  NV_PRIVATE const lobe_params* lp, NV_PRIVATE const node_grid_params* lc,
                                  NV_GLOBAL const nv_float4* dirs, NV_GLOBAL const float* light_cache, vec3 origin,
                                  vec3 dir, vec3 right) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
-  /* L_b, and the view ray stops at the first light surface it meets (they are opaque). */
+  /* L_b; the view ray stops at the first (opaque) light surface it meets. */
   vec3 Lb;
   medium_segment seg;
   if (!march_view(s, lights, origin, dir, &Lb, &seg) || lp->points < 1) return Lb;
 
-  /* 3. Frame (t, b, ω) from the camera's right vector; (t, b, ω) is right-handed. */
+  /* 3. Right-handed frame (t, b, ω). */
   vec3 tx, ty;
   lobe_frame(dir, right, &tx, &ty);
   const int corrected = lp->variant == LOBE_CORRECTED; /* else LOBE_EQ7, the host's only other variant */
@@ -324,16 +284,14 @@ static inline vec3 lobe_radiance(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_pa
                      ? lobe_radiance_corrected(KERNEL_CONTEXT_ARG, mp, lp, lc, dirs, light_cache, origin, dir, tx, ty, Lb, &seg)
                      : lobe_radiance_eq7(KERNEL_CONTEXT_ARG, mp, lp, lc, dirs, light_cache, origin, dir, tx, ty, Lb, &seg);
 #ifdef EMISSION
-  /* The medium's own light, marched with `steps` samples in both variants (the first-hit search's,
-   * 60 by default): corrected's view march has view_steps = 16, which aliases a fire's flames. */
+  /* The medium's own light over `steps` samples in both variants: corrected's view_steps (16) alias flames. */
   return vec3_add(L, march_emission(KERNEL_CONTEXT_ARG, &seg, mp->steps, mp->min_transmittance));
 #else
   return L;
 #endif
 }
 
-/* The pixel (px, py): ray through its centre (deterministic, no jitter). Non-finite results are
- * reported in *status and replaced by 0. */
+/* The pixel (px, py), ray through its centre (no jitter); a non-finite result is reported, then 0. */
 static inline vec3 lobe_pixel(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp, NV_PRIVATE const lobe_params* lp,
                               NV_PRIVATE const node_grid_params* lc, NV_GLOBAL const nv_float4* dirs,
                               NV_GLOBAL const float* light_cache, int px, int py) {

@@ -1,58 +1,44 @@
-/* majorant.h: a coarse majorant grid over the medium box and the 3D DDA that walks it (pbrt-v4's
- * MajorantGrid / DDAMajorantIterator, written as a plain-C iterator a kernel loops over).
- *
- * The box [0, nx]×[0, ny]×[0, nz] in grid index space is cut into cells_x×cells_y×cells_z equal
- * cells of cell_size index units; cell (i, j, k) covers [i, i+1]·cell_size.x × ... and its value
+/* majorant_dda.h: a coarse majorant grid over the medium box and the 3D DDA that walks it (pbrt-v4's
+ * MajorantGrid / DDAMajorantIterator, as a plain-C iterator a kernel loops over).
+ * The index-space box [0, nx]×[0, ny]×[0, nz] is cut into cells_x×cells_y×cells_z cells of cell_size
+ * index units; cell (i, j, k) covers [i, i+1]·cell_size.x × ... and its value
  * cell_max[i + cells_x·(j + cells_y·k)] bounds the trilinear DENSITY anywhere in that closed cell
- * (host/volume/majorant_grid.cpp builds it and proves the bound). σ̄ for a cell is
- * max-channel σt · cell value · MAJORANT_MARGIN, applied by the kernel.
- *
- * The DDA yields, for an index-space ray o + t·d over [t0, t1], the cells it passes through in
- * order as segments [seg_t0, seg_t1] with the cell's value:
- *
+ * (host/volume/majorant_grid.cpp builds it and proves the bound). For an index-space ray o + t·d over
+ * [t0, t1] the DDA yields the cells crossed, in order, as segments [seg_t0, seg_t1] with their value:
  *   majorant_iter it = majorant_iter_begin(grid, o, d, t0, t1);
  *   float s0, s1, smax;
  *   while (majorant_iter_next(&it, cell_max, &s0, &s1, &smax)) { ... }
- *
  * Contract (tests/unit/majorant_grid_test.cpp):
- * - the segments are contiguous and increasing: the first seg_t0 is t0, each seg_t1 is the next
- *   seg_t0, the last seg_t1 is t1, every segment has seg_t1 > seg_t0 (bit-exact: t values are
- *   handed on, never recomputed). t0 >= t1, or a non-finite t0/t1, yields nothing.
- * - a cell the ray passes through with positive length is yielded; a cell it only touches (an
- *   edge or corner crossed exactly) is not: ties between axes step every tied axis at once, so no
- *   zero-length segment appears. A ray running inside a face between two cells (d = 0 on that
- *   axis) walks the cells on the upper side of it; both closed cells bound the density there.
- * - parts of [t0, t1] outside the box belong to the nearest boundary cell (density is 0 there,
- *   so that stays conservative); callers clip to the box first (medium_intersect) to avoid waste.
- * - at most cells_x + cells_y + cells_z - 2 segments (each step advances one axis monotonically
- *   within its range); the loop is also capped at MAJORANT_DDA_BUDGET iterations over the whole
- *   walk (derivation there). next() returning 0 with it.t < it.t_end means that cap was hit: it
- *   sets STATUS_ITERATION_CAP in it.status (it cannot happen by construction; the flag proves it).
- * - a zero or negative-zero direction component never steps on that axis; a start point exactly
- *   on a cell boundary starts in the cell the ray enters (the lower one when d < 0). A
- *   non-finite o, d, t0 or t1 yields nothing and sets STATUS_NAN in it.status (a NaN upstream that
- *   would otherwise read as an empty segment). Callers OR it.status into their status word.
- * Float rounding can place a point the DDA attributes to a cell up to a few ulps of its index
- * coordinates outside that cell; the host build pads every cell by MAJORANT_SLACK index units so
- * the bound holds there too. */
+ * - segments are contiguous and increasing from t0 to t1, each with seg_t1 > seg_t0 (bit-exact: t
+ *   values are handed on, never recomputed); t0 >= t1 yields nothing.
+ * - a cell crossed with positive length is yielded, one only touched (an edge or corner crossed
+ *   exactly) is not: tied axes step at once. A ray inside a face between two cells (d = 0 on that
+ *   axis) walks the upper cells; both closed cells bound the density there.
+ * - parts of [t0, t1] outside the box belong to the nearest boundary cell (density 0 there: still
+ *   conservative); callers clip to the box first (medium_intersect) to avoid waste.
+ * - at most cells_x + cells_y + cells_z - 2 segments (each step advances one axis monotonically), the
+ *   loop capped at MAJORANT_DDA_BUDGET iterations (derivation there): next() returning 0 with
+ *   it.t < it.t_end means the cap was hit, flagged STATUS_ITERATION_CAP (impossible by construction).
+ * - a ±0 direction component never steps on that axis; a start exactly on a cell boundary starts in
+ *   the cell the ray enters (the lower one when d < 0). A non-finite o, d, t0 or t1 yields nothing
+ *   and sets STATUS_NAN (rather than read as an empty segment). Callers OR it.status into theirs. */
 #ifndef NARVAL_MAJORANT_H
 #define NARVAL_MAJORANT_H
 
 #include "shared/structs.h"
 
-/* Relative safety factor on σ̄ = σt_max · cell value: float rounding in the trilinear lerps can
- * exceed the largest corner by a few ulps (the same factor as the global majorant in
- * scene_upload.cpp), so that 1 - σt/σ̄ never goes negative. */
+/* The kernel's σ̄ = max-channel σt · cell value · MAJORANT_MARGIN: the trilinear lerps can exceed the
+ * largest corner by a few ulps; the margin keeps 1 - σt/σ̄ >= 0 (the global majorant's, scene_upload.cpp). */
 #define MAJORANT_MARGIN (1.0f + 1e-5f)
-/* Index units by which the host pads each cell when bounding it (see the note above). */
+/* Index units by which the host pads each cell when bounding it: rounding can place a point the DDA
+ * attributes to a cell a few ulps of its index coordinates outside it. */
 #define MAJORANT_SLACK (1.0f / 256.0f)
 
-/* Loop iterations of majorant_iter_next over a whole walk. Derivation: an iteration either ends
- * the walk (t_exit >= t_end: the last segment, then one more call that returns 0) or steps at least
- * one axis, and an axis steps monotonically from its start cell to its last cell (exit = ∞ there), so
- * at most (nx − 1) + (ny − 1) + (nz − 1) stepping iterations (zero-length segments included) + 2 =
- * nx + ny + nz − 1 < the budget nx + ny + nz + 3. A 64³ majorant grid: ≤ 191 of 195.
- * NARVAL_DDA_BUDGET replaces it by a constant at build time (tests force the cap with it). */
+/* Loop iterations of majorant_iter_next over a whole walk. Derivation: an iteration either ends the
+ * walk (t_exit >= t_end: the last segment, then one call returning 0) or steps at least one axis, each
+ * monotonically from its start cell to its last (exit = ∞ there): at most (nx − 1) + (ny − 1) +
+ * (nz − 1) stepping iterations (zero-length segments included) + 2 = nx + ny + nz − 1 < the budget
+ * nx + ny + nz + 3 (64³: ≤ 191 of 195). NARVAL_DDA_BUDGET replaces it at build time (tests force the cap). */
 #ifdef NARVAL_DDA_BUDGET
 #define MAJORANT_DDA_BUDGET(nx, ny, nz) (NARVAL_DDA_BUDGET)
 #else
@@ -75,11 +61,10 @@ typedef struct majorant_iter {
   uint status;             /* STATUS_NAN (non-finite input), STATUS_ITERATION_CAP (budget spent) */
 } majorant_iter;
 
-/* The cell of coordinate p along one axis, clamped to [0, n-1]: the c with c·size <= p <
- * (c+1)·size, faces formed as the DDA steps on them (float products), so the quotient's rounding is
- * settled against them. A coordinate exactly on a face belongs to the cell the ray enters: the
- * upper one for dir >= 0 (also dir == 0: a ray inside a face walks the upper cells), the lower one
- * for dir < 0. fmin/fmax send NaN to 0, so the int is defined. */
+/* The cell c of coordinate p along one axis, clamped to [0, n-1]: c·size <= p < (c+1)·size, tested
+ * against the faces as the DDA forms them (float products) to settle the quotient's rounding. On a
+ * face: the cell the ray enters, upper for dir >= 0 (dir == 0: a ray inside a face walks the upper
+ * cells), lower for dir < 0. fmin/fmax send NaN to 0, so the int is defined. */
 static inline int majorant_cell_of(float p, float size, float dir, int n) {
   float c = nv_floor(p / size);
   if ((c + 1.0f) * size <= p)
@@ -99,12 +84,11 @@ static inline float majorant_exit_t(int c, int step, int n, float size, float o,
   return NV_INFINITY;
 }
 
-/* The cell the walk starts in along one axis: the position's cell, then settled against the DDA's
- * own crossing times (the expressions majorant_exit_t uses), so that the first exit lies after t0
- * and the cell entered before it. The position o + t0·d carries a rounding error of an ulp of
- * |o| + |t0·d|; on a ray nearly parallel to a face that is a long stretch of t, which the spatial
- * test alone would attribute to the wrong side. One step either way suffices: the error is ulps of
- * the coordinates, far below a cell's width (at least a voxel with chooseMajorantResolution). */
+/* The cell the walk starts in along one axis: the position's cell, settled against the DDA's own
+ * crossing times (majorant_exit_t's expressions) so the first exit lies after t0 and the entry before.
+ * o + t0·d is off by an ulp of |o| + |t0·d|, on a ray nearly parallel to a face a long stretch of t
+ * that the spatial test alone would put on the wrong side. One step either way suffices: the error
+ * is far below a cell's width (at least a voxel with chooseMajorantResolution). */
 static inline int majorant_start_cell(float o, float d, float inv_d, float t0, float size, int n) {
   int c = majorant_cell_of(o + d * t0, size, d, n);
   if (d > 0.0f) {
@@ -169,10 +153,9 @@ static inline int majorant_iter_next(NV_PRIVATE majorant_iter* it, NV_GLOBAL con
     if (!(t_exit < it->t_end)) { /* also a NaN exit (0·inf for a denormal d): stay in this cell */
       it->t = it->t_end;
     } else {
-      /* Step every axis whose boundary lies at t_exit (an edge or corner crossed exactly moves
-       * diagonally, never through a cell the ray only touches); t_exit < t_end makes it a number
-       * equal to at least one of them. A crossing behind `start` (float rounding at the start
-       * point) steps without moving t. */
+      /* Step every axis whose boundary is at t_exit (an edge or corner crossed exactly moves
+       * diagonally, never through a touched cell); t_exit < t_end makes it a number equal to at least
+       * one. A crossing behind `start` (rounding at the start point) steps without moving t. */
       it->t = nv_fmax(start, t_exit);
       if (it->next_x == t_exit) {
         it->cx += it->step_x;
@@ -194,8 +177,7 @@ static inline int majorant_iter_next(NV_PRIVATE majorant_iter* it, NV_GLOBAL con
       it->seg_cell = cell;
       return 1;
     }
-    /* Zero or negative length (rounding at the start point): the ray does not really pass
-     * through this cell; go on to the next one. */
+    /* Zero or negative length (rounding at the start): the ray does not really cross this cell. */
   }
   if (it->t < it->t_end) it->status |= STATUS_ITERATION_CAP; /* budget spent before t_end */
   return 0;

@@ -1,10 +1,7 @@
-/* march.h: what the real-time kernels (raymarch.cl, lobe.cl) take from the lights and the view:
- * the medium's own light along a view segment, a light's in-scattering and shadow column (any
- * light as its one point, light_view_from; an area light over K×K points of it or its exact
- * solid angle, light_rectangle_area.h: the approximation DESIGN.md allows for these kernels, the
- * path tracer always integrating the true light), and the view ray's background and segment.
- * The quadrature itself (true step lengths, samples only in occupied majorant cells) is
- * march_quadrature.h's. */
+/* march.h: what the real-time kernels (raymarch.cl, lobe.cl) take from the lights and the view: the
+ * medium's own light, a light's in-scattering and shadow column (any light as its one point,
+ * light_view_from; area lights: light_rectangle_area.h, the approximation DESIGN.md allows these
+ * kernels, the path tracer integrating the true light), the view ray's background and segment. */
 #ifndef NARVAL_MARCH_H
 #define NARVAL_MARCH_H
 
@@ -15,13 +12,12 @@
 #include "shared/phase.h"
 
 #ifdef EMISSION
-/* The medium's own light along the view segment `seg`: ∫ T(t) σa(t) Le(t) dt (emission.h) over
- * `steps` midpoint samples of its occupied cells, by the energy-conserving step with S = σa·Le
- * (exact for S and σt constant over a step: an absorbing, emitting homogeneous slab gives
- * Le·(1 − e^{−σa·d}) to float rounding). Stops after the step where every channel of T fell below
- * t_stop (0: never): what the rest would add is at most T·max(σa·Le/σt) < t_stop·max Le. For the
- * Lobe Estimator, whose estimate of the lights' light holds none; the ray marcher adds σa·Le inside
- * its own march. */
+/* The medium's own light along view segment `seg`, ∫ T(t) σa(t) Le(t) dt (emission.h), by the
+ * energy-conserving step with S = σa·Le over `steps` midpoint samples of its occupied cells (exact for
+ * S and σt constant over a step: an absorbing, emitting homogeneous slab gives Le·(1 − e^{−σa·d}) to
+ * rounding). Stops after the step where every channel of T fell below t_stop (0: never): the rest adds
+ * at most T·max(σa·Le/σt) < t_stop·max Le. For the Lobe Estimator, whose light estimate holds none;
+ * the ray marcher adds σa·Le inside its own march. */
 static inline vec3 march_emission(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg,
                                   int steps, float t_stop) {
   NV_CONSTANT const medium_params* m = ctx->medium;
@@ -46,9 +42,8 @@ static inline vec3 march_emission(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_
 }
 #endif
 
-/* Light l's unshadowed in-scattering at x per unit σs, Σ_j I_j·p(view_dir·dir_j)/d_j² (view_dir
- * the propagation direction before scattering, e.g. away from the camera): an area light over K×K
- * points of it (light_rectangle_area.h), any other light as its one point (light_view_from). */
+/* Light l's unshadowed in-scattering at x per unit σs, Σ_j I_j·p(view_dir·dir_j)/d_j² (view_dir the
+ * propagation before scattering): an area light over K×K points, any other as its one point. */
 static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                          vec3 view_dir, int K) {
   if (light_has_area(l)) return light_rectangle_phase_sum(l, x, phase, view_dir, K);
@@ -57,16 +52,14 @@ static inline vec3 march_light_phase_sum(NV_CONSTANT const light_params* l, vec3
   return vec3_scale(v.intensity, phase_eval(phase, view_dir, v.dir) / v.range2);
 }
 
-/* The same with the phase integrated exactly over an area light's solid angle (the limit K → ∞);
- * any other light is its one point. */
+/* The same with an area light's phase integrated exactly over its solid angle (K → ∞). */
 static inline vec3 march_light_phase_integral(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                               vec3 view_dir) {
   if (light_has_area(l)) return light_rectangle_phase_integral(l, x, phase, view_dir);
   return march_light_phase_sum(l, x, phase, view_dir, 1);
 }
 
-/* The real-time kernels' phase over a light (march_params.area_light_phase): K×K points
- * (march_light_phase_sum) or the exact integral (march_light_phase_integral). */
+/* The phase over a light per march_params.area_light_phase: K×K points or the exact integral. */
 static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, phase_params phase,
                                      vec3 view_dir, int area_light_phase, int K) {
   switch (area_light_phase) {
@@ -76,9 +69,8 @@ static inline vec3 march_light_phase(NV_CONSTANT const light_params* l, vec3 x, 
   }
 }
 
-/* Column density from x to light l, ∫ρ ds over shadow_steps midpoint samples: an area light's
- * effective column over its K×K points when K > 1 (light_rectangle_column), else the column to the
- * light's one point (a rectangle's centre). */
+/* Column density ∫ρ ds from x to light l over shadow_steps midpoint samples: an area light's effective
+ * column over K×K points when K > 1 (light_rectangle_column), else to its one point (a rectangle's centre). */
 static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const light_params* l,
                                        vec3 x, int K, int shadow_steps, int weighting, vec3 view_dir) {
   NV_PRIVATE uint* status = &ctx->status;
@@ -99,11 +91,10 @@ static inline float march_light_column(KERNEL_CONTEXT_PARAM, NV_CONSTANT const l
   return march_column_density(KERNEL_CONTEXT_ARG, x, dir, d, shadow_steps);
 }
 
-/* A view ray's start, for the real-time kernels and the view cache's columns (ms_cache_view.h):
- * *Lb, what the ray would see with the medium removed (the front of the nearest light surface it
- * hits, black from behind, else the background and the lights at infinity along it), and into *seg
- * its segment through the medium's box, stopped at that surface (the medium behind an emitter is
- * hidden by it: the path tracer's rule). Returns 0 when no medium lies on it. */
+/* A view ray's start, for the real-time kernels and the view cache's columns (ms_cache_view.h): *Lb,
+ * what it sees with the medium removed (the front of the nearest light surface hit, black from behind,
+ * else the background and the lights at infinity along it), and *seg, its segment through the box up to
+ * that surface (an emitter hides the medium behind it: the path tracer's rule). 0: no medium on it. */
 static inline int march_view(NV_CONSTANT const scene_params* s, NV_CONSTANT const light_params* lights, vec3 origin,
                              vec3 dir, NV_PRIVATE vec3* Lb, NV_PRIVATE medium_segment* seg) {
   float t_surf;

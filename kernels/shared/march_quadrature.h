@@ -1,7 +1,6 @@
-/* march_quadrature.h: the real-time kernels' deterministic quadrature along a ray: the
- * energy-conserving step, midpoint samples over the occupied cells of a segment (majorant.h DDA),
- * and the optical depth and column density they give (march.h's shadows and views, the light
- * caches, light_rectangle_area.h). Every step uses its true length (DESIGN.md). */
+/* march_quadrature.h: the real-time kernels' deterministic quadrature along a ray: the energy-conserving
+ * step, midpoint samples over a segment's occupied cells (majorant_dda.h DDA), and the optical depth and
+ * column density of march.h, the light caches and light_rectangle_area.h. Steps keep their true length (DESIGN.md). */
 #ifndef NARVAL_MARCH_QUADRATURE_H
 #define NARVAL_MARCH_QUADRATURE_H
 
@@ -23,18 +22,16 @@ static inline vec3 march_sigma_t(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_s
  * at x = 0 (σt = 0) it is exactly 1, so the step integral is exactly S·Δ, never 0/0. */
 #define MARCH_SERIES_MAX 0.1f
 
-/* (1 − e^{−x})/x for x ≥ 0, given e = e^{−x}: the energy-conserving step integral
- * (S − S·e^{−σtΔ})/σt = S·Δ·march_step_weight(σtΔ). */
+/* (1 − e^{−x})/x for x ≥ 0, given e = e^{−x}: the step integral's weight (below). */
 static inline float march_step_weight(float x, float e) {
   if (x < MARCH_SERIES_MAX)
     return 1.0f - x * (0.5f - x * (1.0f / 6.0f - x * (1.0f / 24.0f - x * (1.0f / 120.0f))));
   return (1.0f - e) / x;
 }
 
-/* One step of a view march (Hillaire 2015's energy-conserving integration): with the source S
- * (radiance per unit length) and σt constant over a step of length Δ, the light it adds is
- * ∫_0^Δ S e^{−σt s} ds = (S − S·e^{−σtΔ})/σt = S·Δ·march_step_weight(σtΔ), seen through the
- * transmittance *T gathered before the step, which then falls by e^{−σtΔ}. */
+/* One view-march step (Hillaire 2015's energy-conserving integration): with the source S (radiance
+ * per unit length) and σt constant over a step Δ it adds ∫_0^Δ S e^{−σt s} ds = (S − S·e^{−σtΔ})/σt
+ * = S·Δ·march_step_weight(σtΔ), seen through the *T before the step, which then falls by e^{−σtΔ}. */
 static inline void march_energy_conserving_step(NV_PRIVATE vec3* L, NV_PRIVATE vec3* T, vec3 S, vec3 sigma_t, float dt) {
   const vec3 x = vec3_scale(sigma_t, dt);
   const vec3 e = vec3_exp_neg(x);
@@ -120,14 +117,12 @@ static inline int march_clip(NV_CONSTANT const medium_params* m, vec3 origin, ve
   return 0;
 }
 
-/* Optical depth τ from `origin` over `dist` along unit `dir`: `steps` midpoint samples over the
- * occupied part of the segment inside the box, Σ σt·Δ. 0 outside the box. The ray marcher's
- * octaves need τ itself (exp(−bⁱτ)), which survives where exp(−τ) underflows. The walk's status
- * bits (march_iter.status) go to *status; a NaN density stays in τ for the caller's pixel check.
- * The march stops early once every channel's partial τ exceeds tau_limit (NV_INFINITY: never, and
- * then the sum is the full one, bit for bit): a view transmittance that is already below
- * e^{−tau_limit} in every channel can only fall further, so what it returns is at most that and at
- * least the true value (lobe.h derives what this costs a pixel). */
+/* Optical depth τ from `origin` over `dist` along unit `dir`: Σ σt·Δ over `steps` midpoint samples of
+ * the occupied part inside the box; 0 outside. The ray marcher's octaves need τ itself (exp(−bⁱτ)),
+ * which survives where exp(−τ) underflows. Status bits go to *status; a NaN density stays in τ for the
+ * caller's pixel check. Stops once every channel's partial τ exceeds tau_limit (NV_INFINITY: never,
+ * the full sum bit for bit): a view transmittance already below e^{−tau_limit} can only fall, so the
+ * result lies between the true value and that (lobe.h derives what this costs a pixel). */
 static inline vec3 march_optical_depth_limited(KERNEL_CONTEXT_PARAM, vec3 origin, vec3 dir,
                                                float dist, int steps, float tau_limit) {
   NV_CONSTANT const medium_params* m = ctx->medium;
@@ -157,9 +152,8 @@ static inline vec3 march_transmittance(KERNEL_CONTEXT_PARAM, vec3 origin, vec3 d
   return vec3_exp_neg(march_optical_depth(KERNEL_CONTEXT_ARG, origin, dir, dist, steps));
 }
 
-/* Column density ∫ρ ds over the same quadrature as march_optical_depth (Σ ρ·Δ): the medium's σt
- * is σt_unit·ρ with one σt_unit per channel, so τ = σt_unit·column for every channel at once; the
- * light-transmittance cache (light_cache.h) stores this one float per node. */
+/* Column density ∫ρ ds by march_optical_depth's quadrature (Σ ρ·Δ): σt = σt_unit·ρ, so
+ * τ = σt_unit·column in every channel at once; the light cache (light_cache.h) stores it per node. */
 static inline float march_column_density(KERNEL_CONTEXT_PARAM, vec3 origin, vec3 dir,
                                          float dist, int steps) {
   NV_CONSTANT const medium_params* m = ctx->medium;

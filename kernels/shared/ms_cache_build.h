@@ -9,26 +9,21 @@
 #include "shared/sampling.h"
 #include "shared/sobol_owen.h"
 
-/* The stream the cache's paths draw from: the scene's seed offset, so that node n's paths never
- * share the numbers of pixel n's camera samples. */
+/* Offsets the scene's seed so that node n's paths never share pixel n's camera samples' numbers. */
 #define MS_CACHE_SEED_OFFSET 0x6d73u
-/* The guide lobes' HG parameter (phase_guide.h; ms_cache.h, "Guide"), compared by the relMSE
- * between two cache seeds, each g at its best share, on the front-lit Disney cloud (g 0.9) and
- * checked on the back-lit one (bench/RESULTS.md). */
+/* The guide lobes' HG g (phase_guide.h; ms_cache.h, "Guide"), chosen by the relMSE between two cache
+ * seeds, each g at its best share, on the front-lit Disney cloud, checked back-lit (bench/RESULTS.md). */
 #define MS_CACHE_GUIDE_G 0.6f
 
-/* The leading coordinates of node `node`'s path k: where in its slice it starts and which light its
- * next-event estimate picks (u[0], u[1]), the direction it leaves in (u[2], u[3]) and the point on
- * the light (u[4], u[5]). The path's result varies smoothly with them (the phase's peak against a
- * wide light, the transmittance falling across the slice), so each pair is a scrambled Sobol
- * sequence over k (sobol_owen.h) rather than independent numbers: every power-of-two prefix of a
- * node's paths is stratified in each pair. It tightens the error bound of the render tests' lit box
- * and lowers two cache seeds' relative MSE on the back-lit Disney cloud, more with the direct light
- * alone (bench/RESULTS.md): the paths' further bounces hold most of the noise, and they draw at
- * random (delta tracking takes as many numbers as it needs). Each node scrambles with its own seeds
- * (drawn once per launch from its own stream at sample index MS_CACHE_LEADING_STREAM, which no path
- * reaches), so nodes' errors stay independent and the cache after K paths is the same whatever
- * launches it was split into. The rest of a path draws from its counter-based stream (rng.h). */
+/* Leading coordinates of node `node`'s path k: its start in the slice and the light its next-event
+ * estimate picks (u[0], u[1]), its direction (u[2], u[3]), the point on the light (u[4], u[5]). The result
+ * varies smoothly with them (the phase's peak against a wide light, the transmittance across the slice),
+ * so each pair is a scrambled Sobol sequence over k (sobol_owen.h), every power-of-two prefix of a node's
+ * paths stratified in it: tighter render-test bounds and less error between cache seeds, most with the
+ * direct light alone (bench/RESULTS.md), since further bounces, drawn at random from the path's
+ * counter-based stream (rng.h; delta tracking takes as many numbers as it needs), hold most of the noise.
+ * Each node's scrambling keys come from its own stream at sample index MS_CACHE_LEADING_STREAM (no path
+ * reaches it): nodes' errors stay independent and K paths give the same cache whatever the launches. */
 #define MS_CACHE_LEADING_STREAM 0xFFFFFFFFu
 #define MS_CACHE_LEADING_KEYS 9 /* three pairs: the index's seed, then each axis's */
 static inline void ms_cache_leading_keys(uint seed, int node, NV_PRIVATE uint* keys) {
@@ -47,11 +42,9 @@ static inline vec3 ms_cache_to_camera(NV_CONSTANT const scene_params* s, vec3 x)
   return d > 0.0f ? vec3_scale(to_camera, 1.0f / d) : vec3_scale(vec3_from4(s->camera.forward), -1.0f);
 }
 
-/* The direction path k looks along, ω: uniform on the sphere (pdf 1/4π: the mean radiance is R and
- * −3·L·ω estimates b), or for MS_CACHE_CLOSURE_CAMERA the reverse of a propagation direction w
- * drawn from the phase function about w_c, the direction to the camera (the mean radiance is then the in-scattering towards the
- * camera; ms_cache.h, "Closure"). ω is then the direction a camera path arriving at x along −w_c
- * would scatter into, drawn as the path tracer draws it, with density *pdf. */
+/* The direction ω path k looks along, density *pdf (ms_cache.h, "Closure"): uniform on the sphere (mean
+ * radiance R, −3·L·ω estimates b), or for the camera closure −w, w drawn from the phase function about w_c:
+ * where a camera path arriving at x along −w_c would scatter, drawn as the path tracer draws it. */
 static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int closure, vec3 w_c, float u1, float u2,
                                       NV_PRIVATE float* pdf) {
   switch (closure) {
@@ -63,14 +56,10 @@ static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int clo
   }
 }
 
-/* Path k's estimate at node `node`, at world point x (a grid node's; a view node's path draws its
- * own in the node's slice, ms_cache_view.h): the radiance of the rest arriving along a direction
- * drawn by ms_cache_direction, and the direction ω it looked along. With the direct
- * light (ms_cache.h, "Direct") the node is a scattering event of a camera path arriving along −w_c:
- * the path tracer's next-event estimate there, and the emitter the first segment meets weighted
- * against it by MIS, as at any event of a path-traced pixel. With the guide (ms_cache.h, "Guide")
- * the direction comes from phase_guide_sample instead, weighted by phase/mixture density, and the
- * mixture's density is the one both MIS weights name. */
+/* Path k's estimate at node `node` and the direction ω it looked along: the rest's radiance arriving
+ * at world point x (a grid node's; a view node's path draws its own in the slice, ms_cache_view.h),
+ * plus the next-event estimate with the direct light (ms_cache.h, "Direct"). With the guide ("Guide")
+ * ω comes from phase_guide_sample, weighted by phase/mixture density; both MIS weights use the mixture's. */
 static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int node,
                                  NV_GLOBAL const float* v, vec3 x, NV_PRIVATE const uint* keys, uint k,
                                  NV_PRIVATE vec3* omega) {
@@ -104,13 +93,11 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache
   return status_finite_or_zero(status, L);
 }
 
-/* Whether a lookup can read node `node`. The march looks the cache up only at samples of positive
- * density, and a sample reads the eight nodes of its cell, each within one node spacing h of it
- * along every axis; the majorant grid bounds the density in each of its cells (majorant.h). So a
- * node is read only if a majorant cell overlapping [p − h, p + h] (p the node's index-space point;
- * widened by the cells' own padding, MAJORANT_SLACK) has a positive bound: the build skips the
- * others, the empty space around a cloud or a plume.
- * Without a majorant grid (the global majorant): every node. */
+/* Whether a lookup can read node `node`. Lookups happen only at samples of positive density and read their
+ * cell's eight nodes, each within one node spacing h per axis; the majorant grid bounds the density per
+ * cell (majorant_dda.h). So a node is read only if a majorant cell overlapping [p − h, p + h] (p its index-space
+ * point, widened by MAJORANT_SLACK) has a positive bound; the build skips the others, the empty space
+ * around a cloud. Without a majorant grid (the global majorant): every node. */
 static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_PRIVATE const node_grid_params* c, int node) {
   NV_CONSTANT const medium_params* m = ctx->medium;
   const majorant_grid_params g = m->majorant_grid;
@@ -131,9 +118,8 @@ static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_PRIVATE const n
   return 0;
 }
 
-/* Adds paths [first, first + count) to node `node`'s running means (ms_cache.h, "Storage"), the
- * node at world point x: v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch; then
- * ln R and b/R. */
+/* Adds paths [first, first + count) to the running means of node `node` at world point x (ms_cache.h,
+ * "Storage": v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch), then ln R and b/R. */
 static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, vec3 x,
                                         int node, NV_GLOBAL float* v, uint first, uint count) {
   uint keys[MS_CACHE_LEADING_KEYS];
@@ -161,10 +147,9 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
 }
 
 
-/* One launch's work for node `node` (ms_cache.cl): paths [first, first + count) at the node's point,
- * for the cache's layout. A grid node no lookup reads is left at 0 (ms_cache_node_is_read); a view
- * node's slice is where ms_view_place_column put it, it takes no paths when its column holds no
- * medium, and none past its budget when it has one (MS_VIEW_BUDGET). */
+/* One launch's work for node `node` (ms_cache.cl): paths [first, first + count). A grid node no lookup
+ * reads stays 0 (ms_cache_node_is_read); a view node (placed by ms_view_place_column) takes none when
+ * its column holds no medium, nor past its budget (MS_VIEW_BUDGET). */
 static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int node,
                                        NV_GLOBAL float* v, uint first, uint count) {
   NV_PRIVATE const node_grid_params* c = &mc->grid;
@@ -175,9 +160,8 @@ static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms
                              affine_point(c->index_to_world, node_grid_point(c, vec3_from4(ctx->medium->dims), node)),
                              node, v, first, count);
       return;
-    case MS_CACHE_LAYOUT_VIEW: { /* placed once per cache by ms_cache_place_view; each path draws its point */
+    case MS_CACHE_LAYOUT_VIEW: { /* each path draws its point in the slice */
       if (!(v[MS_VIEW_TAU] >= 0.0f)) return;
-      /* A budget (the host's perceptual allocation) stops the node at its own number of paths. */
       const uint budget = (uint)v[MS_VIEW_BUDGET];
       if (budget > 0u) {
         if (first >= budget) return;

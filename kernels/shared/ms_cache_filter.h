@@ -1,47 +1,37 @@
-/* ms_cache_filter.h: a filter over the view cache's nodes (ms_cache_view.h) that averages
- * neighbouring columns where they agree within their noise. A node's paths are few on an
- * interactive CPU build, and their noise is most of the view cache's error; wider tiles average
- * more paths per pixel but mix columns whose in-scattering differs (even with many paths a node,
- * tile 2's bilinear mix alone errs more than tile 1: bench/RESULTS.md). What separates columns that
- * may be mixed from those that may not is J itself: a guide from the single scattering does not (in
- * a cloud of albedo 0.99 most of J is multiple scattering; the back-lit cloud's dark ring holds
- * none at all), so the range distance is the nodes' own difference measured in their noise, as in
- * non-local-means filtering of Monte Carlo renders (Rousselle, Knaus & Zwicker 2012, "Adaptive
- * rendering with non-local means filtering", Eq. 4), with the column's slices as the patch:
- *
+/* ms_cache_filter.h: a filter over the view cache's nodes (ms_cache_view.h) that averages neighbouring
+ * columns where they agree within their noise. On an interactive CPU build a node's paths are few and
+ * their noise is most of the view cache's error; wider tiles average more paths per pixel but mix columns
+ * whose in-scattering differs (bench/RESULTS.md). What tells columns that may be mixed apart is J itself,
+ * not a guide from the single scattering (at albedo 0.99 most of J is multiple scattering; a back-lit
+ * cloud's dark ring holds none), so the range distance is the nodes' own difference measured in their
+ * noise, as in non-local-means filtering of Monte Carlo renders (Rousselle, Knaus & Zwicker 2012,
+ * "Adaptive rendering with non-local means filtering", Eq. 4), with the column's slices as the patch:
  *   d²_j = (1/nz) Σ_s max(0, (J_j,s − J_s)² − (v_s + v_j,s)) / (ε + k²·(v_s + v_j,s)),
- *
- * J_s the grey (channel-mean) value of the column's slice s = [τ_a, τ_b], J_j,s column j's slices
- * integrated over that same τ range (ms_view_lookup with column j alone: registered by optical
- * depth as the lookup is, so a column whose surface lies deeper is read at the same depth under its
- * surface, and the column's own reads give its own J̄_s exactly), v_s, v_j,s the variances of those
- * means (the running mean of the grey L², MS_CACHE_SQUARE, less J², over the paths n; for j, of
- * its slice holding the range's midpoint): a neighbour whose differences are within the noise
- * (d² = 0) weighs as much as the column itself; k (msCache.filterTolerance) sets how many standard
- * errors beyond it a neighbour keeps e^{−1} of its weight. The filtered column:
- *
+ * J_s the grey (channel-mean) value of slice s = [τ_a, τ_b]; J_j,s column j's slices integrated over that
+ * τ range (ms_view_lookup with column j alone: registered by optical depth as the lookup is, and the
+ * column's own reads give its J̄_s exactly); v_s, v_j,s the variances of those means (mean grey L²,
+ * MS_CACHE_SQUARE, less J², over the paths n; for j, of its slice holding the range's midpoint). A
+ * neighbour within the noise (d² = 0) weighs as much as the column itself; k (msCache.filterTolerance)
+ * sets how many standard errors beyond it keep e^{−1} of the weight. The filtered column:
  *   J̃_s = Σ_j w_j·J_j,s / Σ_j w_j,   w_j = e^{−(Δx² + Δy²)/(2σ_s²)} · e^{−d²_j},
+ * over the columns j with medium within max(1, ⌊2σ_s⌋) on each axis, one weight per column for all its
+ * slices; σ_s in columns (msCache.filter; 0: off). A patch rather than one node makes the distance less
+ * noisy and measured better on most scenes (bench/RESULTS.md). Weights that depend on the noise bias the
+ * filter where true differences hide in it (the price of every such denoiser); k → ∞ is a plain Gaussian.
+ * It reads the running means and writes a second buffer of the same layout (R filtered, other slots
+ * copied; the view lookup reads R alone) for the march, after every build launch, so the raw means keep
+ * refining and the weights tighten as the noise falls.
  *
- * over the columns j within max(1, ⌊2σ_s⌋) of it on each axis that hold medium, one weight per
- * column for all its slices. σ_s is in columns (msCache.filter; 0: off). A patch of the column's
- * slices rather than one node: the distance is less noisy, and it measured better on most
- * scenes tried (bench/RESULTS.md). The weights depend on the noise, so the filter is biased where true
- * differences hide in it (the price of every such denoiser); k → ∞ is a plain Gaussian. The filter
- * reads the running means and writes a second buffer of the same layout (R filtered, the other
- * slots copied; the view lookup reads R alone), which the march reads; it runs after every build
- * launch, so the raw means keep refining and the weights tighten as the noise falls.
- *
- * Twicing (msCache.filterTwicing; Tukey 1977, "Exploratory Data Analysis", ch. 16): the filter S,
- * with its weights fixed by the raw means, is linear, and where the in-scattering curves its bias
- * is (S − I)·J ≈ (m₂/2)·∇²J, m₂ the weights' second moment: a dark column among brighter ones (the
- * back-lit Disney cloud's ring, where J is convex across the image) reads too bright. Filtering the
- * residual and adding it back, J̃ = S(J) + S(J − S(J)) = 2·S(J) − S(S(J)), cancels that term (a
- * field quadratic in the columns comes back exactly, where S alone is off by m₂) for a kernel
- * 2S − S² that keeps more weight at the centre, so more of the noise. A second pass computes it
- * from the first pass's output (ms_view_filter_column with `residual` set), with the same weights,
- * and clamps it at 0 (radiance: where the field dips more sharply than a quadratic, 2S − S² can
- * overshoot below it). On the back-lit Disney cloud the filter alone reads the mid-dark bands too
- * bright; twicing takes most of that out and lowers the JND (bench/RESULTS.md). */
+ * Twicing (msCache.filterTwicing; Tukey 1977, "Exploratory Data Analysis", ch. 16): S, its weights fixed
+ * by the raw means, is linear, and where the in-scattering curves its bias is (S − I)·J ≈ (m₂/2)·∇²J, m₂
+ * the weights' second moment: a dark column among brighter ones (J convex across the image, as in a
+ * back-lit cloud's ring) reads too bright. Filtering the residual and adding it back,
+ * J̃ = S(J) + S(J − S(J)) = 2·S(J) − S(S(J)), cancels that term (a field quadratic in the columns comes
+ * back exactly, where S alone is off by m₂) for a kernel 2S − S² that keeps more weight, so more noise,
+ * at the centre. A second pass computes it from the first's output (ms_view_filter_column with
+ * `residual`), same weights, clamped at 0 (radiance: where the field dips more sharply than a quadratic,
+ * 2S − S² can overshoot below it); it takes out most of the filter's brightening of mid-dark bands
+ * (bench/RESULTS.md). */
 #ifndef NARVAL_MS_CACHE_FILTER_H
 #define NARVAL_MS_CACHE_FILTER_H
 
@@ -57,8 +47,7 @@ static inline float ms_view_grey_variance(NV_GLOBAL const float* v) {
   return v[3] > 0.0f ? nv_fmax(0.0f, v[MS_CACHE_SQUARE] - J * J) / v[3] : 0.0f;
 }
 
-/* Column j's read over node (column, s)'s τ range, as ms_view_lookup reads one column, and the
- * variance of j's slice holding that range's midpoint. */
+/* Column j read over node v's τ range (J_j,s), and the variance of j's slice at its midpoint (v_j,s). */
 static inline vec3 ms_view_filter_read(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache,
                                        NV_GLOBAL const float* v, int j, NV_PRIVATE float* variance) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
@@ -71,11 +60,10 @@ static inline vec3 ms_view_filter_read(NV_PRIVATE const node_grid_params* c, NV_
   return ms_view_lookup(c, cache, &one, a, b - a);
 }
 
-/* Column `column`'s filtered slices ("The filtered column"), σ_s = sigma_s columns, k = tolerance,
- * written to `out` (the filtered buffer at the column's slice 0: J̃ in slots 0–2, the rest copied
- * from `cache`); a column without medium is copied. The weights come from `cache`, the running
- * means; the values averaged from `values`: the running means again (S(J)), or with `residual` set
- * the first pass's output F, and then the column gets 2·F − S(F), at least 0 ("Twicing"). */
+/* Column `column`'s filtered slices ("The filtered column"; σ_s = sigma_s, k = tolerance) into `out`
+ * (the filtered buffer at the column's slice 0: J̃ in slots 0–2, the rest copied; a column without
+ * medium is copied). Weights from `cache`, the running means; values from `values`: the running means
+ * (S(J)), or with `residual` the first pass's output F, giving max(0, 2·F − S(F)) ("Twicing"). */
 static inline void ms_view_filter_column(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache,
                                          NV_GLOBAL const float* values, int residual, int column, float sigma_s,
                                          float tolerance, NV_GLOBAL float* out) {

@@ -1,45 +1,39 @@
-/* ms_cache_view.h: the multiple-scattering cache laid out in view space (MS_CACHE_LAYOUT_VIEW;
- * ms_cache.h holds what a node estimates and how). The grid layout spends its nodes evenly over the
- * medium's box; in a dense cloud lit from the camera's side the scattered light lives in a layer a
- * few mean free paths thick under the visible surface, thinner than a cell, and the grid cannot
- * resolve it (the front-lit Disney cloud's multiple scattering reads well below the path tracer's
- * at 16–64 cells: bench/RESULTS.md). What a pixel sees of the in-scattering is
+/* ms_cache_view.h: the multiple-scattering cache laid out in view space (MS_CACHE_LAYOUT_VIEW; ms_cache.h
+ * holds what a node estimates and how). In a dense cloud lit from the camera's side the scattered light
+ * lives in a layer a few mean free paths under the visible surface, thinner than a cell of the grid
+ * layout, which spreads its nodes evenly over the box and cannot resolve it (bench/RESULTS.md). What a
+ * pixel sees of the in-scattering is
  *   ∫ T(t) σs(t) J(t) dt = ∫ (σs/σt) J e^{−τ} dτ,     τ the optical depth from the camera,
- * so the nodes that matter are those spread evenly in e^{−τ} along the view rays: the layout of
- * production engines' froxels (frustum-aligned voxels; Hillaire 2015, "Physically based and unified
- * volumetric rendering in Frostbite"), with the depth axis taken in optical depth instead of
- * distance so that the nodes follow the medium's surface wherever it is.
+ * so the nodes that matter are spread evenly in e^{−τ} along the view rays: production engines' froxels
+ * (frustum-aligned voxels; Hillaire 2015, "Physically based and unified volumetric rendering in
+ * Frostbite"), with depth in optical depth, not distance, so that the nodes follow the medium's surface.
  *
- * Layout (node_grid_params ms_cache: nx·ny columns, nz = slices per column; node (cx, cy, s) at index
- * cx + nx·(cy + ny·s), MS_CACHE_STRIDE floats each): column (cx, cy) is the camera ray through the
- * image point ((cx + ½)·tile, (cy + ½)·tile), tile = ms_cache_params.tile pixels. Along it
- * (once per cache, before any paths: ms_view_place_column), τ(t) is marched with
- * MS_VIEW_PLACE_STEPS samples over its occupied majorant cells (march.h), in the grey extinction σ̄t
- * (the mean of the three channels, per unit density), to its total τ_end (march_column_density;
- * levels stop at τ_max = −ln MS_VIEW_T_MIN: past it the pixel sees under 1% of the medium), and
- * cut at the levels where the transmittance has fallen to
- *   T_i = 1 − (1 − T_end)·i/nz,   i = 0 … nz,   T_end = max(e^{−τ_end}, MS_VIEW_T_MIN):
- * node s is the slice [τ_s, τ_{s+1}], an equal share of what the pixel sees. A column that meets no
- * density stores τ = −1 and no paths.
+ * Layout (nx·ny columns of nz slices; node (cx, cy, s) at cx + nx·(cy + ny·s), MS_CACHE_STRIDE floats
+ * each): column (cx, cy) is the camera ray through image point ((cx + ½)·tile, (cy + ½)·tile),
+ * tile = ms_cache_params.tile pixels. Once per cache (ms_view_place_column), the grey τ (σ̄t the channel
+ * mean per unit density) is marched along it to its total τ_end (march_column_density,
+ * MS_VIEW_PLACE_STEPS samples over occupied majorant cells) and cut where the transmittance has fallen to
+ *   T_i = 1 − (1 − T_end)·i/nz,   i = 0 … nz,   T_end = max(e^{−τ_end}, MS_VIEW_T_MIN)
+ * (levels stop at τ_max = −ln MS_VIEW_T_MIN, past which the pixel sees under 1% of the medium): node s is
+ * the slice [τ_s, τ_{s+1}], an equal share of what the pixel sees. A column meeting no density stores
+ * τ = −1 and takes no paths.
  *
- * A node holds the slice's mean, not a point's value: its paths start at points drawn along the
- * column with density ∝ e^{−τ} over the slice (T uniform between T_s and T_{s+1}; ms_view_sample_point
- * marches the slice to the drawn τ), each aimed at the camera (the camera closure), so the node
- * estimates J̄_s = ∫_s J e^{−τ} dτ / ∫_s e^{−τ} dτ, and Σ_s (T_s − T_{s+1})·J̄_s is the column's own
- * in-scattering ∫ J e^{−τ} dτ exactly (for the grey σs/σt of a medium of one albedo). Point nodes
- * interpolated linearly in τ were biased where J falls steeply under the surface (convex in τ): the
- * back-lit Disney cloud's darker half read brighter than the path tracer's at 8 slices (bench/RESULTS.md).
+ * A node holds the slice's mean, not a point's value: its paths start along the column with density
+ * ∝ e^{−τ} over the slice (T uniform in [T_{s+1}, T_s]: ms_view_sample_point), aimed at the camera (the
+ * camera closure), so it estimates J̄_s = ∫_s J e^{−τ} dτ / ∫_s e^{−τ} dτ, and Σ_s (T_s − T_{s+1})·J̄_s
+ * is the column's in-scattering ∫ J e^{−τ} dτ exactly (for the grey σs/σt of a medium of one albedo).
+ * Point values interpolated linearly in τ are biased where J falls steeply (convex in τ) under the
+ * surface (bench/RESULTS.md).
  *
- * Lookup: a pixel's sample at grey optical depth τ (its own march's, ms_view_columns) reads its
- * four nearest columns, bilinear in image space; each column's slices are integrated over the
- * sample's march step (ms_view_lookup; the last slice runs on past its end), and columns without
- * medium drop out (the weights of the others renormalised). Reading by τ rather than by distance keeps a pixel's layers registered with
- * its neighbours' when the surface is at different depths in them (a bump, a silhouette): the slice
- * one mean free path under the surface is read one mean free path under the pixel's own surface.
- * Errors: the tile's blur (the in-scattering varies more slowly in the image than the single
- * scattering, which the march computes per pixel), the slices' width where the pixel's τ profile
- * differs from its column's, and the paths' noise, which the lookup averages over four nodes.
- * The cache depends on the camera and the image size: the host starts it over when either changes. */
+ * Lookup (ms_view_lookup): a sample at grey optical depth τ of the pixel's own march reads its four
+ * nearest columns (ms_view_columns) bilinearly, each column's slices integrated over the march step (the
+ * last slice running on past its end); columns without medium drop out, the others' weights renormalised.
+ * Reading by τ, not distance, keeps a pixel's layers registered with its neighbours' where the surface
+ * depth differs (a bump, a silhouette): one mean free path under the surface is read one mean free path
+ * under the pixel's own surface. Errors: the tile's blur (in-scattering varies more slowly in the image
+ * than single scattering, which the march computes per pixel), the slices' width where the pixel's τ
+ * profile differs from its column's, and the paths' noise, averaged over four nodes. The cache depends on
+ * the camera and image size: the host starts it over when either changes. */
 #ifndef NARVAL_MS_CACHE_VIEW_H
 #define NARVAL_MS_CACHE_VIEW_H
 
@@ -47,17 +41,15 @@
 #include "shared/march.h"
 #include "shared/ms_cache.h"
 
-/* A node's slice, written by the placement: its grey optical depths from the camera and distances
- * along its column's ray at both ends (τ = −1: the column holds no medium). Slots the running means
- * leave free (ms_cache.h, "Storage"). */
+/* A node's slice, written by the placement in slots the running means leave free (ms_cache.h,
+ * "Storage"): grey optical depth from the camera and distance along the ray at both ends (τ = −1: no medium). */
 #define MS_VIEW_TAU 29
 #define MS_VIEW_T 30
 #define MS_VIEW_TAU_END 31
 #define MS_VIEW_T_END 19
-/* The paths a node takes (ms_cache_build.h; 0: as many as each launch asks), written by the host's
- * perceptual allocation (render/ms_cache_allocation.h); and on a column's slice 0, the background's
- * light through the column's last level, T_end·grey(L_b) (T_end ≥ MS_VIEW_T_MIN), which that
- * allocation weighs by. */
+/* BUDGET: the paths a node takes (ms_cache_build.h; 0: as each launch asks), from the host's perceptual
+ * allocation (render/ms_cache_allocation.h). SEEN, on slice 0: the background's light through the
+ * column's last level, T_end·grey(L_b), which that allocation weighs by. */
 #define MS_VIEW_BUDGET 7
 #define MS_VIEW_SEEN 15
 #define MS_VIEW_T_MIN 0.01f
@@ -75,9 +67,8 @@ static inline float ms_view_sigma_t(NV_CONSTANT const medium_params* m) {
   return (st.x + st.y + st.z) / 3.0f;
 }
 
-/* A march step's grey optical depth at sample t (the step's middle; march_iter), and where within
- * the step, τ(t) linear over it, the depth gathered before it (acc) plus the step's own (d) reaches
- * `level`: the placement's and the path starts' walk along a column. */
+/* A march step's grey optical depth at sample t (its middle), and where in the step, τ linear over
+ * it, acc + d reaches `level`: the walk of the placement and of the path starts along a column. */
 static inline float ms_view_step_depth(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg, float sigma,
                                        float t, float delta) {
   return sigma * nv_fmax(grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t)), 0.0f) * delta;
@@ -104,10 +95,8 @@ static inline void ms_view_store_level(NV_GLOBAL float* cache, size_t slice_stri
   }
 }
 
-/* Places column `column`'s slices ("Layout"), once per cache (ms_cache_place_view, before any
- * paths): marches the column for τ_end, then once more to every level, and writes each node's ends
- * (MS_VIEW_TAU …), which the build then reads instead of marching the column at every launch.
- * `cache` points at the column's first node (slice 0); slice s is nx·ny nodes further. */
+/* Places column `column`'s slices ("Layout"; ms_cache_place_view): writes each node's ends (MS_VIEW_TAU …)
+ * so the build need not march the column at every launch. `cache`: slice 0; slice s is nx·ny nodes on. */
 static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int column,
                                         NV_GLOBAL float* cache) {
   NV_CONSTANT const scene_params* s = ctx->scene;
@@ -147,10 +136,9 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
   for (; i <= c->nz; ++i) ms_view_store_level(cache, slice_stride, i, c->nz, ms_view_level(t_end, i, c->nz), end);
 }
 
-/* A path's start in node `node`'s slice ("A node holds the slice's mean"): τ drawn with density
- * ∝ e^{−τ} on [τ_s, τ_{s+1}] from u (T = T_s − u·(T_s − T_{s+1})), and the point where the column
- * reaches it, marched across the slice in MS_VIEW_SAMPLE_STEPS steps (the slice's end when rounding
- * leaves it short). The node must hold medium (v[MS_VIEW_TAU] ≥ 0). */
+/* A path's start in node `node`'s slice ("A node holds the slice's mean"): T = T_s − u·(T_s − T_{s+1}),
+ * and where the column reaches that τ, marched across the slice (its end when rounding leaves the
+ * march short). The node must hold medium (v[MS_VIEW_TAU] ≥ 0). */
 static inline vec3 ms_view_sample_point(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int node,
                                         NV_GLOBAL const float* v, float u) {
   NV_CONSTANT const scene_params* s = ctx->scene;
@@ -186,8 +174,7 @@ typedef struct ms_view_columns {
   float w[4];
 } ms_view_columns;
 
-/* One axis: the lower column and the weight of the upper one for the pixel centre's position u in
- * column units; one column alone takes it all. */
+/* One axis: the lower column and the upper one's weight at position u in column units. */
 static inline int ms_view_axis(float u, int n, NV_PRIVATE float* w) {
   if (n < 2) {
     *w = 0.0f;
@@ -215,17 +202,15 @@ static inline ms_view_columns ms_view_locate(NV_PRIVATE const ms_cache_params* m
 /* 1 − e^{−x} for x ≥ 0, accurate for small x (march_step_weight's series). */
 static inline float ms_view_one_minus_exp(float x) { return x * march_step_weight(x, nv_exp(-x)); }
 
-/* The in-scattering towards the camera per unit σs over a march step from grey optical depth tau
- * to tau + dtau, for the pixel whose columns are `cols` ("Lookup"); 0 where none of them holds
- * medium. Each column's slices make J(τ) piecewise constant, so the step's mean under the weight
- * it gets in the step, e^{−(τ − tau)} (the energy-conserving step's, march.h), is exact:
+/* The in-scattering towards the camera per unit σs over a march step, grey optical depth tau to tau + dtau,
+ * for the pixel's columns `cols` ("Lookup"); 0 where none holds medium. J(τ) is piecewise constant over a
+ * column's slices, so its mean under the step's weight e^{−(τ − tau)} (the energy-conserving step's,
+ * march.h) is exact:
  *   J_step = Σ_s J̄_s·(e^{−(lo_s − tau)} − e^{−(hi_s − tau)}) / (1 − e^{−dtau}),
- * [lo_s, hi_s] the part of slice s inside the step (the first slice reaching back to 0, the last on
- * to ∞). A point read at the step's middle was a quadrature of its own: 60 steps through the
- * back-lit Disney cloud cross several slices each near its surface, and the image then depended on
- * the step count (bench/RESULTS.md). The weight is the grey τ's; a chromatic medium's channels fall
- * at their own rates within a step. A step inside one slice (most of them) and dtau = 0 read the
- * slice holding tau, with no exponential. */
+ * [lo_s, hi_s] slice s's part of the step (the first slice reaching back to 0, the last on to ∞). A point
+ * read at the step's middle, a quadrature of its own, made the image depend on the step count where steps
+ * cross slices near the surface (bench/RESULTS.md). The weight is the grey τ's (a chromatic medium's
+ * channels fall at their own rates). A step inside one slice, and dtau = 0, read that slice. */
 static inline vec3 ms_view_lookup(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache,
                                   NV_PRIVATE const ms_view_columns* cols, float tau, float dtau) {
   const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;

@@ -1,23 +1,16 @@
 /* pathtrace.h: one path-traced sample of a pixel (DESIGN.md "pathtrace"; dissertation §4.2-4.3).
- * Free flight by delta/spectral tracking, next-event estimation at every real scattering event
- * (ratio-tracked shadow rays to every light or to one picked per event (light_select.h), lights
- * with an extent MIS-combined with phase sampling by the power heuristic, delta lights by NEE
- * alone; light.h), Russian roulette on shadow rays as the scene asks (tracking.h), `max_bounces`
- * real scattering events; a ray adds the light surface it hits, or on escaping the background and
- * the lights at infinity along it. Light surfaces are opaque: a rectangle's back side is black.
- * No Russian roulette on the path's throughput (pbrt-v4's volumetric path tracer has one): here it
- * could never play. The grey analogue walk keeps β = 1, and spectral tracking keeps the mean of β's
- * channels at 1 (tracking.h: a real or null event multiplies β by σ_x·c/(σ̄·avg(σ_x ⊙ β)) with
- * c = σ̄·avg(β)), so β is never below 1 in every channel; absorption already ends paths in
- * proportion to the energy they lose.
- * Status word: STATUS_NAN for a non-finite sample (written as 0) or a NaN met on the way (density,
- * majorant, phase value: tracking.h and below); STATUS_NEGATIVE_PDF for a phase-sampled direction
- * whose pdf is not positive and for a majorant below σt (tracking.h); STATUS_ITERATION_CAP from the
- * tracking walks' cap (tracking.h). Majorant (grid or global) and counters (-DCOUNTERS): tracking.h.
- * Emissive media (-DEMISSION): the free-flight walk of every segment adds the medium's own light
- * to L (tracking.h, pbrt-v4's estimator), the camera's segment and every one after a scattering
- * event alike: emission seen after k scattering events is light of k bounces, as an emitter or the
- * background the path reaches. */
+ * Free flight by delta/spectral tracking; next-event estimation at every real scattering event
+ * (ratio-tracked shadow rays to every light or one picked per event, light_select.h; lights with an
+ * extent MIS-combined with phase sampling by the power heuristic, delta lights by NEE alone: light.h);
+ * Russian roulette on shadow rays as the scene asks; `max_bounces` real events. A ray adds the light
+ * surface it hits (opaque: a rectangle's back is black), or on escaping the background and the lights
+ * at infinity along it. No Russian roulette on the throughput (pbrt-v4 has one): it could never play,
+ * as the grey walk keeps β = 1 and spectral tracking avg(β) = 1 (an event multiplies β by
+ * σ_x·c/(σ̄·avg(σ_x ⊙ β)), c = σ̄·avg(β)), so β is never below 1 in every channel; absorption already
+ * ends paths in proportion to the energy they lose. Status bits, majorants, counters: tracking.h,
+ * plus STATUS_NAN for a non-finite sample (written as 0) or phase value and STATUS_NEGATIVE_PDF for a
+ * phase-sampled direction without positive pdf. Emission (-DEMISSION) seen after k scattering events
+ * is added by that segment's walk (tracking.h): light of k bounces, as an emitter or background reached. */
 #ifndef NARVAL_PATHTRACE_H
 #define NARVAL_PATHTRACE_H
 
@@ -45,11 +38,10 @@ static inline vec3 pathtrace_shadow(KERNEL_CONTEXT_PARAM, int light_index, vec3 
   return tracking_ratio(KERNEL_CONTEXT_ARG, seg.o, seg.d, seg.t0, seg.t1, s->shadow_roulette, rng);
 }
 
-/* Light i's next-event estimate at a scattering point x for a path arriving along w_in, divided by
- * the probability of aiming at it (light_select_prob, as the MIS weight of a rectangle hit uses),
- * aimed at the light point that (u1, u2) picks; the shadow ray draws from rng. gd: how the event
- * draws its next direction (phase_guide.h; phase_guide_none(): the phase function), the density MIS
- * weighs the light's against. */
+/* Light i's next-event estimate at scattering point x for a path arriving along w_in, aimed at the
+ * light point (u1, u2) picks, divided by the probability of aiming at it (light_select_prob, as a
+ * rectangle hit's MIS weight uses); the shadow ray draws from rng. gd: how the event draws its next
+ * direction (phase_guide.h; phase_guide_none(): the phase function), the density MIS weighs against. */
 static inline vec3 pathtrace_light_at(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 w_in, float u1, float u2,
                                       phase_guide gd, NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const scene_params* s = ctx->scene;
@@ -79,13 +71,11 @@ static inline vec3 pathtrace_light(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 w_i
   return pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, phase_guide_none(), rng);
 }
 
-/* The direct light at x (pathtrace_direct, below) with its leading coordinates given: u_select
- * picks the light (one per event), (u1, u2) the point on it (every light aims at the point (u1, u2)
- * picks on it); the shadow rays draw from rng. For a caller that stratifies them over many
- * estimates at one point (the multiple-scattering cache's paths, ms_cache_build.h). The path
- * tracer's own events draw everything from rng in turn (pathtrace_direct: one light's numbers after
- * another's shadow ray, no light point drawn when none can be picked), which this cannot share. gd:
- * how the caller draws the event's next direction (pathtrace_light_at). */
+/* pathtrace_direct with its leading numbers given: u_select picks the light (one per event), (u1, u2)
+ * the point aimed at on every light; shadow rays draw from rng. For callers stratifying them over many
+ * estimates at one point (ms_cache_build.h); the path tracer draws all from rng in turn (a light's
+ * numbers after the previous shadow ray, none when no light can be picked), which this cannot share.
+ * gd: as in pathtrace_light_at. */
 static inline vec3 pathtrace_direct_at(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, float u_select, float u1, float u2,
                                        phase_guide gd, NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const scene_params* s = ctx->scene;
@@ -125,9 +115,8 @@ static inline vec3 pathtrace_direct(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, NV_
   }
 }
 
-/* What the lights at infinity send along −d to a ray escaping the scene along d, each MIS-weighted
- * against its next-event estimate as a light surface's hit is (prev_phase_pdf 0: the camera's ray,
- * unweighted). */
+/* What the lights at infinity send along −d to a ray escaping along d, each MIS-weighted against its
+ * next-event estimate as a light surface hit is (prev_phase_pdf 0: the camera's ray, unweighted). */
 static inline vec3 pathtrace_escaped(KERNEL_CONTEXT_PARAM, vec3 d, float prev_phase_pdf) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
@@ -144,13 +133,12 @@ static inline vec3 pathtrace_escaped(KERNEL_CONTEXT_PARAM, vec3 d, float prev_ph
   return sum;
 }
 
-/* Radiance arriving at o from the direction −d, by one path: the ray o + t·d, then up to max_bounces
- * real scattering events. unscattered_emitters 0 drops the emitter the first segment may hit (the
- * unscattered light of the lights, which the ray marcher adds itself: the multiple-scattering
- * cache, ms_cache.h); the background seen through the medium is kept either way. first_phase_pdf:
- * 0 when o is the camera; else o is a scattering event whose next-event estimate the caller made
- * and d was drawn from the phase function with this density, which weights (MIS) an emitter the
- * first segment hits, as at every later event. Non-finite results are left to the caller's check. */
+/* Radiance arriving at o from −d by one path: the ray o + t·d, then up to max_bounces real scattering
+ * events. unscattered_emitters 0 drops the emitter the first segment may hit (the lights' unscattered
+ * light, which the ray marcher adds itself: ms_cache.h), keeping the background. first_phase_pdf: 0
+ * when o is the camera, else the phase pdf d was drawn with at event o (whose next-event estimate the
+ * caller made), for the MIS weight of an emitter the first segment hits. Non-finite results are left
+ * to the caller's check. */
 static inline vec3 pathtrace_radiance(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, int unscattered_emitters,
                                       float first_phase_pdf, NV_PRIVATE rng_state* rng_in) {
   NV_CONSTANT const scene_params* s = ctx->scene;
@@ -160,10 +148,9 @@ static inline vec3 pathtrace_radiance(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, int 
   vec3 L = vec3_splat(0.0f), beta = vec3_splat(1.0f);
   float prev_phase_pdf = first_phase_pdf; /* 0: the ray left the camera, no MIS on what it hits */
   int depth = 0;
-  /* Bounded without a cap of its own: every iteration either ends the path (break) or is a real
-   * scattering event that takes depth one closer to max_bounces (checked before the increment, so
-   * bounces = INT_MAX cannot overflow it): at most max_bounces + 1 iterations, each of whose walks
-   * is capped (tracking.h). Reaching max_bounces is the requested truncation, not a status. */
+  /* Loops: at most max_bounces + 1 iterations, each ending the path or a real event taking depth
+   * towards max_bounces (checked before the increment: bounces = INT_MAX cannot overflow), each walk
+   * capped (tracking.h). Reaching max_bounces is the requested truncation, not a status. */
   for (;;) {
     float t_surf;
     int front = 0;

@@ -1,77 +1,58 @@
 /* raymarch.h: real-time single scattering by ray marching (DESIGN.md "raymarch"; Hillaire 2015,
- * "Physically based and unified volumetric rendering in Frostbite"), with the multiple-scattering
- * octave approximation (Wrenninge et al. 2013, "Oz: the great and volumetric"; Hillaire 2016,
- * "Physically based sky, atmosphere and cloud rendering in Frostbite"). Deterministic: one ray
- * through the pixel centre, fixed quadrature, no random numbers.
+ * "Physically based and unified volumetric rendering in Frostbite"), with the multiple-scattering octave
+ * approximation (Wrenninge et al. 2013, "Oz: the great and volumetric"; Hillaire 2016, "Physically based
+ * sky, atmosphere and cloud rendering in Frostbite"). Deterministic: one ray through the pixel centre,
+ * fixed quadrature, no random numbers. Parameters: march_params (structs.h).
  *
- * Parameters (march_params, structs.h):
- * | field        | meaning                                                                  |
- * |--------------|--------------------------------------------------------------------------|
- * | steps        | samples over the occupied part of the view ray's box segment, true length  |
- * | shadow_steps | samples per shadow ray, clipped to the box                                |
- * | octaves      | N; 1 = plain single scattering                                            |
- * | octave_a/b/c | per-octave scale of σs, of the shadow ray's σt, of the HG g               |
- *
- * Per view ray o + t·d, its segment [t0, t1] inside the box (clipped at the rectangle light it
- * hits, as the path tracer does), Δ = (t1 − t0)/steps, sample x_k at the midpoint of step k:
+ * Per view ray o + t·d, its segment [t0, t1] inside the box (clipped at the rectangle light it hits, as
+ * the path tracer does) gets `steps` samples x_k, midpoints of steps of equal true length Δ over the
+ * occupied majorant cells only (march_iter, march.h: empty space costs nothing):
  *   S_k = σs(x_k) ⊙ Σ_lights (I/d²) ⊙ Σ_{i<N} aⁱ · p(g·cⁱ, μ) · exp(−bⁱ·τ(x_k → light))
  *   L  += T ⊙ (S_k − S_k ⊙ e^{−σt(x_k)·Δ}) / σt(x_k)      (energy-conserving step, exact for
  *   T  ⊙= e^{−σt(x_k)·Δ}                                     S and σt constant over the step)
- * and the pixel is L + T ⊙ L_b (L_b: march_view, what the ray sees with the medium removed).
- * Lights are points (light_view_from: a rectangle is a point at its centre with intensity
- * Le·A·max(0, cos θ_light), the approximation DESIGN.md allows here) unless area_light_samples
- * K > 1 (the phase and 1/d² over K×K points of a rectangle) or area_light_phase is AREA_LIGHT_EXACT
- * (the phase integrated over the rectangle's solid angle, march_light_phase); other emitters do not
- * block shadow rays. μ is the cosine between the light's propagation direction (light → x) and the
- * scattered one (x → camera, −d): dot(d, direction to the light), as in pathtrace_direct.
+ * and the pixel is L + T ⊙ L_b (L_b: march_view, what the ray sees with the medium removed). Zero density
+ * changes nothing (S = 0, e^{−0} = 1) and skips the light loop. Lights: march_light_sum (march_lights.h),
+ * rectangles as points at their centres with intensity Le·A·max(0, cos θ_light) as DESIGN.md allows here,
+ * unless area_light_samples or area_light_phase ask for more (structs.h); other emitters do not block
+ * shadow rays. μ = dot(d, direction to the light), the cosine between the light's propagation (light → x)
+ * and the scattered direction (x → camera, −d), as in pathtrace_direct. τ: light_cache_optical_depth, a
+ * light-cache lookup or a march of shadow_steps samples clipped to the box.
  *
- * Octaves: octave i scatters with σs·aⁱ, sees the light through the shadow transmittance with
- * extinction σt·bⁱ, i.e. Tr^(bⁱ) = exp(−bⁱ·τ) with τ computed once, and uses the phase function
- * with g·cⁱ; the view ray's transmittance T is not scaled. Octave 0 is plain single scattering and
- * is computed by exactly the same arithmetic whether N is 1 or more; the others are added only
- * when N > 1, so the a, b, c values cannot change an N = 1 image.
- * Bound: every octave term is ≥ 0, so N octaves are never darker than one. With b = c = 1 each
- * octave is octave 0 scaled by aⁱ, so L_N = L_1 · Σ_{i<N} aⁱ = L_1 · (1 − a^N)/(1 − a) ≤ L_1/(1 − a)
- * (a < 1; the loader keeps a ≤ b ≤ 1). For b < 1 or c < 1 no multiple of L_1 bounds L_N: Tr^(bⁱ)
- * ≥ Tr can be larger by any factor deep in a dense medium (that is the point of the octaves), and
- * HG with a smaller |g| exceeds HG(g) away from the peak. What does hold for any a, b, c: since
- * exp(−bⁱτ) ≤ 1 and p(g', μ) ≤ p_max = (1 + |g|)/(4π(1 − |g|)²) for |g'| ≤ |g|,
+ * Octaves (N = octaves): octave i scatters with σs·aⁱ, sees the light through Tr^(bⁱ) = exp(−bⁱ·τ)
+ * (extinction σt·bⁱ, τ computed once) and uses the phase function with g·cⁱ; the view ray's T is not
+ * scaled. Octave 0 is plain single scattering by the same arithmetic whatever N; the others are added
+ * only when N > 1, so a, b, c cannot change an N = 1 image.
+ * Bound: every octave term is ≥ 0, so N octaves are never darker than one. With b = c = 1 each octave is
+ * octave 0 scaled by aⁱ, so (a < 1; the loader keeps a ≤ b ≤ 1)
+ *   L_N = L_1 · Σ_{i<N} aⁱ = L_1 · (1 − a^N)/(1 − a) ≤ L_1/(1 − a).
+ * For b < 1 or c < 1 no multiple of L_1 bounds L_N: Tr^(bⁱ) ≥ Tr can be larger by any factor deep in a
+ * dense medium (the point of the octaves), and HG with a smaller |g| exceeds HG(g) away from the peak.
+ * For any a, b, c, since exp(−bⁱτ) ≤ 1 and p(g', μ) ≤ p_max = (1 + |g|)/(4π(1 − |g|)²) for |g'| ≤ |g|,
  *   L_N − T ⊙ L_b ≤ p_max · Σ_{i<N} aⁱ · U ≤ p_max/(1 − a) · U,
- * U the same march with the phase function and the shadow transmittance replaced by 1: bounded
- * whenever a < 1. (a ≤ b keeps each octave's effective albedo σs·aⁱ/(σt·bⁱ) ≤ σs/σt.)
+ * U the same march with phase function and shadow transmittance replaced by 1: bounded whenever a < 1.
+ * (a ≤ b keeps each octave's effective albedo σs·aⁱ/(σt·bⁱ) ≤ σs/σt.)
  *
- * Shadow rays: light_cache_optical_depth (light_cache.h): one lookup in the light-transmittance
- * cache when it is on, else a march of shadow_steps samples.
+ * In the same energy-conserving step, S_k gains σs(x_k) ⊙ (R + g·b·w_out) from the multiple-scattering
+ * cache (ms_cache.h; ms_cache_params.grid.nx > 0): the in-scattering towards the camera of the radiance
+ * at x_k the light sum does not hold (scattered at least once, and the background), from its directional
+ * average R and first moment b; and with -DEMISSION (emission.h) σa(x_k) ⊙ Le(x_k), the medium's own
+ * light (an absorbing, emitting homogeneous slab: Le·(1 − e^{−σa·d})), the bound below then taking
+ * A ≥ max Le.
  *
- * Multiple-scattering cache (ms_cache.h; ms_cache_params.grid.nx > 0): S_k gains σs(x_k) ⊙ (R + g·b·w_out),
- * the in-scattering towards the camera of the radiance arriving at x_k that the light sum above
- * does not hold (scattered at least once, and the background), by its directional average R and
- * first moment b, inside the same energy-conserving step.
+ * Early termination (min_transmittance = ε > 0; 0 never stops): the march stops after the step where
+ * every channel of T fell below ε' = ε / max(1, max channel of L_b); the pixel is L + T·L_b with the T
+ * reached. Per channel, the rest of the march would have added
+ *   Σ_{k'} T_{k'}·(S_{k'}/σt_{k'})·(1 − e^{−σt_{k'}Δ}) ≤ T·A·(1 − T_rest),
+ * A = sup of S/σt = albedo · Σ_lights (I/d²) · Σ_i aⁱ p(g cⁱ, μ) e^{−bⁱτ} over the rest of the segment,
+ * and the L_b term changes from T·T_rest·L_b to T·L_b, by T·(1 − T_rest)·L_b; of opposite signs, so
+ * |ΔL| ≤ T·max(A, L_b) < ε·max(A, L_b)/max(1, L_b) ≤ ε·max(A, 1). Scaling ε by L_b keeps a dark pixel
+ * before a bright emitter (Listing 4.1's light behind the cloud, L_b = 20) from showing ε·L_b of light
+ * the medium hides: an absolute error ε = 10⁻³ is under ΔL* = 1 even at black (L* = 903.3·Y below
+ * Y = 0.0089). A bound the host can evaluate: A ≤ max albedo · Σ_lights I/d_min² · p_max · Σ_{i<N} aⁱ,
+ * d_min the light's distance from the box (tests/render/light_cache_render_test.cpp).
  *
- * Emission (-DEMISSION, emission.h): S_k gains σa(x_k) ⊙ Le(x_k), the medium's own light, inside
- * the same energy-conserving step (an absorbing, emitting homogeneous slab: Le·(1 − e^{−σa·d})).
- * The early-termination bound below then takes A ≥ max Le as well.
- *
- * Early termination (min_transmittance = ε > 0; 0 never stops): the march stops after the step
- * where every channel of T fell below ε' = ε / max(1, max channel of L_b), and the pixel is L + T·L_b
- * with the T reached. Error bound, per channel: what the rest of the march would have added is
- * Σ_{k'} T_{k'}·(S_{k'}/σt_{k'})·(1 − e^{−σt_{k'}Δ}) (the energy-conserving step) ≤ T·A·(1 − T_rest),
- * with A = sup of S/σt = albedo · Σ_lights (I/d²) · Σ_i aⁱ p(g cⁱ, μ) e^{−bⁱτ} over the rest of the
- * segment, and the L_b term changes from T·T_rest·L_b to T·L_b, by T·(1 − T_rest)·L_b; the two have
- * opposite signs, so |ΔL| ≤ T·max(A, L_b) < ε·max(A, L_b)/max(1, L_b) ≤ ε·max(A, 1). Scaling ε by
- * L_b keeps a dark pixel in front of a bright emitter (Listing 4.1's light behind the cloud, L_b =
- * 20) from showing ε·L_b of light the medium hides: in display terms an absolute error ε = 10⁻³
- * is under ΔL* = 1 even at black (L* = 903.3·Y below Y = 0.0089). A bound the host can evaluate:
- * A ≤ max albedo · Σ_lights I/d_min² · p_max · Σ_{i<N} aⁱ, d_min the light's distance from the box
- * (tests/render/light_cache_render_test.cpp checks it).
- *
- * Empty space: the `steps` samples are spread over the occupied majorant cells only (march_iter in
- * march.h), so empty parts of the box cost nothing and the step is shorter where there is medium.
- * Samples of zero density change nothing (S = 0, e^{−0} = 1) and skip the light loop.
- *
- * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density or ray met on the
- * way; STATUS_ITERATION_CAP when a DDA walk spends its budget (majorant.h). Nothing is sampled, so
- * there is no pdf and never STATUS_NEGATIVE_PDF. */
+ * Status word: STATUS_NAN for a non-finite pixel (written as 0) or a NaN density or ray met on the way;
+ * STATUS_ITERATION_CAP when a DDA walk spends its budget (majorant_dda.h); no pdf, never STATUS_NEGATIVE_PDF. */
 #ifndef NARVAL_RAYMARCH_H
 #define NARVAL_RAYMARCH_H
 
@@ -86,10 +67,9 @@ typedef struct raymarch_accum {
   vec3 L, T;
 } raymarch_accum;
 
-/* The multiple-scattering cache's in-scattering towards the camera per unit σs for the march step
- * at index-space point p (its middle), from grey optical depth tau to tau + dtau along the view ray:
- * the grid layout's at p (ms_cache.h), the view layout's over the step for the pixel whose columns
- * are `cols` (ms_cache_view.h). */
+/* The multiple-scattering cache's in-scattering towards the camera per unit σs for the march step at
+ * index-space point p (its middle), grey optical depth tau to tau + dtau: the grid layout's at p
+ * (ms_cache.h), the view layout's over the step for the pixel's columns `cols` (ms_cache_view.h). */
 static inline vec3 raymarch_ms_cache(NV_PRIVATE const ms_cache_params* mc, NV_CONSTANT const medium_params* m,
                                      NV_GLOBAL const float* ms_cache, NV_PRIVATE const ms_view_columns* cols, vec3 p,
                                      float tau, float dtau, vec3 dir) {
@@ -102,13 +82,10 @@ static inline vec3 raymarch_ms_cache(NV_PRIVATE const ms_cache_params* mc, NV_CO
   }
 }
 
-/* Marches the view ray origin + t·dir over its box segment `seg` in `steps` steps of equal true
- * length spread over the occupied cells (march_iter: empty cells are skipped), sampled at their
- * midpoints; stops once every channel of T is below t_stop (0: never; see "Early termination").
- * `cols`: the pixel's columns of a view-space multiple-scattering cache (ms_cache_view.h).
- * Loops: `steps` samples (march_next, its piece walk capped by the DDA budget), each
- * with num_lights shadow marches of shadow_steps samples and `octaves` (≤ 16) terms: all bounded by
- * the scene's own parameters, no cap of their own. */
+/* Marches the view ray origin + t·dir over its box segment `seg` until every channel of T is below t_stop
+ * (0: never; "Early termination"); `cols`: the pixel's view-cache columns. Loops: `steps` samples
+ * (march_next, its piece walk capped by the DDA budget), each with num_lights shadow marches of
+ * shadow_steps samples and `octaves` (≤ 16) terms: bounded by the scene's parameters, no cap of their own. */
 static inline void raymarch_segment(KERNEL_CONTEXT_PARAM, NV_PRIVATE const march_params* mp,
                                     NV_PRIVATE const node_grid_params* lc, NV_PRIVATE const ms_cache_params* mc,
                                     NV_GLOBAL const float* light_cache, NV_GLOBAL const float* ms_cache,

@@ -46,10 +46,9 @@ typedef struct camera_params {
   int pad1;
 } camera_params;
 
-/* One emitter. Rectangle: corner + s*edge_u + t*edge_v, s,t in [0,1], emitting along `normal`
- * (one-sided) with radiance `radiance`; normal.w holds the area. Point: `corner` is the position,
- * `radiance` the intensity in W/sr. select_prob: the probability that next-event estimation picks
- * this light when it picks one light per event (light_select.h). */
+/* One emitter. Rectangle: corner + s*edge_u + t*edge_v, s,t in [0,1], emitting `radiance` one-sided
+ * along `normal`; normal.w holds the area. Point: `corner` is the position, `radiance` the intensity in
+ * W/sr. select_prob: the chance NEE picks this light when it picks one per event (light_select.h). */
 typedef struct light_params {
   nv_float4 corner;
   nv_float4 edge_u;
@@ -62,9 +61,8 @@ typedef struct light_params {
   int pad1;
 } light_params;
 
-/* The coarse majorant grid over the medium's index box (host/volume/majorant_grid.h): cells of
- * cell_size index units; the per-cell density bounds travel in their own buffer. Walked by the DDA
- * in majorant.h. */
+/* The coarse majorant grid over the medium's index box (host/volume/majorant_grid.h; the DDA in
+ * majorant_dda.h); the per-cell density bounds travel in their own buffer. */
 typedef struct majorant_grid_params {
   nv_float4 cell_size; /* xyz: index units per cell along each axis (dims / cells); w unused */
   int cells_x;
@@ -73,10 +71,9 @@ typedef struct majorant_grid_params {
   int pad0;
 } majorant_grid_params;
 
-/* Emission of the medium (pbrt-v4's model: σa(x)·Le(x) per unit length). The emission grid has an
- * index space of its own (its own transform and bounding box in the file); index_to_grid maps the
- * medium's index space into it. B is the blackbody table (host/colour/blackbody.h): table_size
- * linear-sRGB entries over [0, table_max] kelvin, evenly spaced, 0 at or below 100 K. */
+/* Emission of the medium (pbrt-v4's model: σa(x)·Le(x) per unit length). The emission grid has its
+ * own index space (transform and bounding box in the file). The blackbody table (host/colour/blackbody.h):
+ * table_size linear-sRGB entries evenly over [0, table_max] kelvin, 0 at or below 100 K. */
 typedef struct emission_params {
   nv_affine index_to_grid; /* medium index space → emission grid index space */
   nv_float4 grid_dims;     /* the emission grid's resolution; x = 0: no grid (v = 1) */
@@ -99,9 +96,8 @@ typedef struct phase_params {
   int pad2;
 } phase_params;
 
-/* The participating medium: an axis-aligned box [0, dims] in grid index space (voxel i covers
- * [i, i+1], its centre at i + 0.5), reached from world space through one affine map. Coefficients
- * are per unit density and already include the material's density multiplier D. */
+/* The participating medium: the box [0, dims] in grid index space (grid.h), reached from world space by
+ * one affine map. Coefficients are per unit density, times the material's density multiplier D. */
 typedef struct medium_params {
   nv_affine world_to_index;
   nv_float4 dims;       /* grid resolution as floats; (1,1,1) for a homogeneous box */
@@ -130,9 +126,8 @@ typedef struct node_grid_params {
 #define LOBE_EQ7 0
 #define LOBE_CORRECTED 1
 
-/* How the real-time kernels integrate the phase function over a rectangle light (march_light_phase):
- * K×K points (K = march_params.area_light_samples; 1, the centre, is the dissertation's), or the
- * exact solid-angle integral (phase_polygon.h). */
+/* The real-time kernels' phase over a rectangle light (march_light_phase): K×K points
+ * (K = march_params.area_light_samples; 1, the centre, is the dissertation's) or exact (phase_polygon.h). */
 #define AREA_LIGHT_POINTS 0
 #define AREA_LIGHT_EXACT 1
 
@@ -146,9 +141,8 @@ typedef struct node_grid_params {
 #define MS_CACHE_INTERPOLATION_GEOMETRIC 0
 #define MS_CACHE_INTERPOLATION_LINEAR 1
 
-/* How a rectangle light's shadow averages its K×K points (march_light_column): by each point's share
- * of the light reaching x (cos θ/d²), or (PHASE) of the light x scatters towards the camera
- * (p(θ)·cos θ/d², the phase for the direction from the camera to x). */
+/* How a rectangle's shadow weights its K×K points (march_light_column): by each point's share of the
+ * light reaching x (cos θ/d²), or (PHASE) of the light x scatters towards the camera (p(θ)·cos θ/d²). */
 #define SHADOW_WEIGHTING_AREA 0
 #define SHADOW_WEIGHTING_PHASE 1
 
@@ -157,11 +151,11 @@ typedef struct node_grid_params {
 #define MS_CACHE_LAYOUT_GRID 0
 #define MS_CACHE_LAYOUT_VIEW 1
 
-/* The real-time kernels' parameters, one block per feature, each a kernel argument of its own
- * (passed by value, bound by name: host/cl/kernel_args.cpp). DESIGN.md "raymarch", "lobe". */
+/* The real-time kernels' parameters, one block per feature, each its own kernel argument (by value,
+ * bound by name: host/cl/kernel_args.cpp). DESIGN.md "raymarch", "lobe". */
 
-/* The marches of the ray marcher and the lobe (and the light cache's build, which marches the
- * shadow rays they would): sample counts, early stop, how rectangle lights are integrated. */
+/* The marches of the ray marcher, the lobe and the light cache's build (which marches their shadow
+ * rays): sample counts, early stop, how rectangle lights are integrated. */
 typedef struct march_params {
   int steps;                /* raymarch: samples over the view ray's segment; lobe: first-hit search samples */
   int shadow_steps;         /* samples per shadow ray (and per light-cache node when the cache is built) */
@@ -200,7 +194,7 @@ typedef struct ms_cache_params {
   int filter_twicing;     /* the view layout, filter on: 1: the residual filtered and added back ("Twicing") */
   float filter;           /* the view layout: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
   float filter_tolerance; /* the filter's k: standard errors a neighbour may differ by */
-  float guide;            /* closure camera: share of a path's first direction drawn towards the lights (phase_guide.h) */
+  float guide;            /* closure camera: share of first path directions drawn towards the lights (phase_guide.h) */
   int pad0;
   int pad1;
   int pad2;

@@ -1,14 +1,10 @@
-/* tracking.h: null-collision free-flight and transmittance estimators (dissertation §4.2) against
- * a majorant σ̄ >= σt: per cell of the majorant grid (default) or one global σ̄ over the box.
- *
- * Free flight: delta tracking (Algorithm 1). For a grey medium (σt equal in all channels) it is
- * the analogue walk: at a tentative collision, absorb with P = σa/σ̄, scatter with P = σs/σ̄, else
- * continue; the path throughput never changes. For chromatic σ it becomes spectral tracking (Kutz
- * et al. 2017, §4.2, history-aware average collision probabilities): P_x ∝ avg(σ_x ⊙ β) for
- * x in {a, s, n} and β ⊙= σ_x / (σ̄ P_x) on the chosen event, which is unbiased per channel and
- * reduces to the analogue walk when σ is grey.
- * Transmittance: ratio tracking (Algorithm 2), Tr ⊙= 1 − σt(x)/σ̄, per channel; closed form for a
- * homogeneous medium. */
+/* tracking.h: null-collision free flight and transmittance (dissertation §4.2) against a majorant
+ * σ̄ >= σt, per majorant-grid cell (default) or one global σ̄ over the box.
+ * Free flight: delta tracking (Algorithm 1). Grey σ: the analogue walk (absorb with P = σa/σ̄,
+ * scatter with σs/σ̄, else go on; the throughput never changes). Chromatic σ: spectral tracking (Kutz
+ * et al. 2017, §4.2, history-aware average collision probabilities), P_x ∝ avg(σ_x ⊙ β) for x in
+ * {a, s, n}, β ⊙= σ_x/(σ̄ P_x) on the chosen event: unbiased per channel, analogue when σ is grey.
+ * Transmittance: ratio tracking (Algorithm 2), Tr ⊙= 1 − σt(x)/σ̄ per channel; closed form if homogeneous. */
 #ifndef NARVAL_TRACKING_H
 #define NARVAL_TRACKING_H
 
@@ -19,17 +15,13 @@
 #include "shared/sampling.h"
 #include "shared/structs.h"
 
-/* Iteration cap of both walks below; hitting it sets STATUS_ITERATION_CAP and ends the walk
- * (delta: absorbed, ratio: transmittance 0). Derivation: the tentative collisions of a walk over a
- * segment of length ℓ are a Poisson process of rate σ̄, so a walk takes 1 + Poisson(σ̄ℓ) steps. The
- * densest scene among the tests and benchmarks (σt = 1e6 over a unit box, hard_cases_numeric) has
- * σ̄ℓ ≈ 1e6 at the very most (its walks end at the first real collision), the dissertation's clouds
- * σ̄ℓ < 1e4; P(Poisson(1e6) > 1e7) is 0 in any precision. The cap trips only for σ̄ℓ ≳ 1e7, which is
- * also where float arithmetic gives out: the mean step 1/σ̄ ≈ 1e-7·ℓ is then about an ulp of t
- * wherever t is of the order of ℓ or more (2⁻²³·t ≈ 1.2e-7·t), so t no longer follows the
- * exponential steps it samples and, a little denser, t + step rounds back to t: the walk stands
- * still. Hitting the cap is slow but bounded (StatusWord.OverDenseGridHitsTheTrackingCapWithoutHelp
- * prints its cost; bench/RESULTS.md).
+/* Iteration cap of both walks; hitting it sets STATUS_ITERATION_CAP and ends the walk (delta: absorbed,
+ * ratio: 0). A walk over a length ℓ takes 1 + Poisson(σ̄ℓ) steps (with the grid Poisson(∫σ̄_grid), fewer;
+ * the DDA under the walk has its own budget, majorant_dda.h). The densest test scene (σt = 1e6 over a unit box,
+ * hard_cases_numeric) has σ̄ℓ ≈ 1e6 at most, the dissertation's clouds < 1e4, and P(Poisson(1e6) > 1e7)
+ * is 0 in any precision. At σ̄ℓ ≳ 1e7 float gives out anyway: the mean step 1/σ̄ ≈ 1e-7·ℓ is an ulp of
+ * t ≳ ℓ (2⁻²³ ≈ 1.2e-7), so t + step rounds back to t. Slow but bounded
+ * (StatusWord.OverDenseGridHitsTheTrackingCapWithoutHelp; bench/RESULTS.md).
  * NARVAL_TRACKING_MAX_STEPS overrides it at build time (tests force the cap with a small value). */
 #ifndef NARVAL_TRACKING_MAX_STEPS
 #define NARVAL_TRACKING_MAX_STEPS 10000000
@@ -40,45 +32,28 @@
 #define TRACK_SCATTERED 1
 #define TRACK_ABSORBED 2
 
-/* Status bits of the walks (structs.h), besides the cap:
- * - STATUS_NAN: a non-finite majorant (NaN, or +inf: σ·D overflowing float; steps of 1/inf = 0
- *   would never advance), a NaN density or NaN throughput. The walk ends (delta: absorbed, ratio:
- *   transmittance 0) instead of treating the NaN as a null collision, which would drop it silently.
- * - STATUS_NEGATIVE_PDF: σt(x) > σ̄ somewhere on the walk, i.e. the null-collision probability
- *   σn/σ̄ = 1 − σt(x)/σ̄ (delta) or the ratio-tracking weight (ratio) is negative: the majorant does
- *   not bound the medium and the estimate is biased. The global σ̄ = max σt · max ρ · (1 + 1e-5)
- *   (scene_upload.cpp) rules this out for any grid whose maxValue is its true maximum (loaders
- *   compute it); the grid's cells are built from the voxels themselves (majorant_grid.cpp proves the
- *   bound), so maxValue does not enter. The walk goes on, as before.
- * Both walks check medium_params.majorant (finite, positive) in either mode: the grid's σ̄ per cell
- * is at most that (a cell value is at most the largest voxel), so it is finite too, and a medium
- * whose global σ̄ is 0 has only empty cells. The cap counts tentative collisions: with the grid
- * they are Poisson(∫σ̄_grid) <= Poisson(σ̄ℓ), so the derivation above holds; the DDA under the walk
- * has its own budget (majorant.h). */
+/* Status bits besides the cap (structs.h). STATUS_NAN: a non-finite majorant (NaN, or +inf from σ·D
+ * overflowing: steps of 1/inf = 0 never advance), density or throughput; the walk ends (delta:
+ * absorbed, ratio: 0) rather than drop the NaN silently as a null collision. STATUS_NEGATIVE_PDF:
+ * σt(x) > σ̄, so σn/σ̄ = 1 − σt(x)/σ̄ or the ratio weight is negative and the estimate biased; the walk
+ * goes on. Ruled out by the global σ̄ = max σt · max ρ · (1 + 1e-5) (scene_upload.cpp) when maxValue is
+ * the true maximum (loaders compute it), and by construction for grid cells (majorant_grid.cpp). Both
+ * walks check medium_params.majorant (finite, positive) in either mode: it bounds every cell's σ̄ (0: all
+ * cells empty). */
 
-/* ---- Majorants: the grid (pbrt-v4's DDAMajorantIterator) or one global σ̄ ------------------------
- *
- * Grid (default): the walk follows the majorant grid's cells along the ray (majorant.h DDA); over a
- * cell σ̄ = max-channel σt · cell value · MAJORANT_MARGIN (majorant.h, the cell value bounds the
- * trilinear density there). Global: one segment [t, t_max] with σ̄ = medium_params.majorant.
- * Chosen at build time, so neither kernel carries the other's branch:
- * - device: -DMAJORANT_GLOBAL selects the global majorant (the host passes it for --majorant global,
- *   and for auto on GPUs: host/render/majorant_options.h); MEDIUM_HOMOGENEOUS also takes it (its one
- *   cell would give the same σ̄, without a DDA);
- * - host: -DMAJORANT_GLOBAL likewise, else the grid when the grid_view carries majorant cells and
- *   the medium has cells (a runtime test: host tests walk both ways in one binary).
- *
- * Free-flight sampling across segments (the budget). A tentative collision is where the majorant's
- * optical depth from the previous one reaches τ = −ln(1 − u), u uniform (Exp(1)). The walk spends τ
- * segment by segment: in a segment [s0, s1] with σ̄_i > 0 at position t, if t + τ/σ̄_i < s1 the
- * collision is there; else τ −= σ̄_i·(s1 − t) and the walk moves on to s1 with what is left. A cell
- * with σ̄_i = 0 spends nothing and is crossed without a density lookup or a random number. This is
- * exactly a sample of the inhomogeneous Poisson process of rate σ̄(t) (the inverse of its
- * cumulative rate), so pbrt-v4's alternative, a fresh u at every boundary (memorylessness), has the
- * same distribution; carrying τ uses one uniform per collision, as the global walk does. With one
- * segment the arithmetic is the global walk's, bit for bit (t + (−ln(1−u))/σ̄, the same compare).
- * Rounding: t + τ/σ̄_i >= s1 while σ̄_i·(s1 − t) > τ by an ulp leaves τ < 0, clamped to 0 (a
- * collision at the next segment's start: an ulp-sized shift of a measure-zero event). */
+/* Majorants, chosen at build time so neither kernel carries the other's branch: the grid (pbrt-v4's
+ * DDAMajorantIterator; majorant_dda.h), per cell σ̄ = max-channel σt · cell value · MAJORANT_MARGIN, or one
+ * segment [t, t_max] with σ̄ = medium_params.majorant. Device: -DMAJORANT_GLOBAL (--majorant global,
+ * auto on GPUs: host/render/majorant_options.h) or MEDIUM_HOMOGENEOUS (one cell: the same σ̄, no DDA)
+ * take the global one. Host: -DMAJORANT_GLOBAL likewise, else the grid when grid_view and medium have
+ * majorant cells (a runtime test: host tests walk both ways in one binary).
+ * Free flight across segments (the budget): a tentative collision is where the majorant's optical
+ * depth since the previous one reaches τ = −ln(1 − u) ~ Exp(1). In [s0, s1] with σ̄_i > 0 at t: if
+ * t + τ/σ̄_i < s1 the collision is there, else τ −= σ̄_i·(s1 − t), on to s1; a cell with σ̄_i = 0 costs
+ * no lookup or random number. This samples the Poisson process of rate σ̄(t) exactly (inverting its
+ * cumulative rate), as pbrt-v4's fresh u per boundary does (memorylessness), with one uniform per
+ * collision; one segment is the global walk bit for bit. An ulp of rounding can leave τ < 0: clamped
+ * to 0, a collision at the next segment's start (measure zero). */
 #if defined(MAJORANT_GLOBAL) || (defined(NV_DEVICE) && defined(MEDIUM_HOMOGENEOUS))
 #define TRACKING_USE_MAJORANT_GRID(m) 0
 #elif defined(NV_DEVICE)
@@ -90,9 +65,8 @@
 #endif
 
 /* Grey or chromatic σ (scene specialisation, host/render/kernel_features.h): -DMEDIUM_GREY keeps only
- * the analogue walk in tracking_delta, -DMEDIUM_CHROMATIC only spectral tracking; the host sets one
- * exactly when medium_params.grey says so, so the walk taken is the generic kernel's, bit for bit.
- * Neither: the runtime flag. */
+ * the analogue walk, -DMEDIUM_CHROMATIC only spectral tracking; the host sets one exactly when
+ * medium_params.grey says so (the generic kernel's walk, bit for bit). Neither: the runtime flag. */
 #if defined(MEDIUM_GREY)
 #define TRACKING_GREY(m) 1
 #elif defined(MEDIUM_CHROMATIC)
@@ -101,18 +75,13 @@
 #define TRACKING_GREY(m) ((m)->grey)
 #endif
 
-/* Counters (-DCOUNTERS): tentative and real collisions and density lookups, counted into the
- * context's track_counters (kernel_context.h) by TRACK_COUNT. */
+/* -DCOUNTERS: TRACK_COUNT counts tentative and real collisions and lookups (kernel_context.h). */
 
-/* Emission (-DEMISSION, emission.h): tracking_delta also collects the medium's own light into
- * *emitted, pbrt-v4's estimator: at every tentative collision t_i (null or real, before its event
- * is chosen) it adds β ⊙ σa(t_i)·Le(t_i)/σ̄(t_i), β the throughput there. Unbiased: tentative
- * collisions that the walk reaches without a real event before them arrive with density
- * σ̄(t)·T(t) (thinning of the Poisson process of rate σ̄; with spectral tracking β carries each
- * channel's T(t)/(the walk's own survival)), so the expected sum is ∫ T(t) σa(t) Le(t) dt, the
- * emission term of the segment up to its end, for any majorant (grid or global). A real collision
- * ends the segment: the emission beyond it belongs to the paths that scatter there. Without
- * EMISSION the parameter and the lookups vanish. */
+/* Emission (-DEMISSION, emission.h), pbrt-v4's estimator: at every tentative collision t_i (null or
+ * real, before its event is chosen) tracking_delta adds β ⊙ σa(t_i)·Le(t_i)/σ̄(t_i) to *emitted.
+ * Unbiased for either majorant: tentative collisions before any real event have density σ̄(t)·T(t)
+ * (thinning; under spectral tracking β carries each channel's T(t)/(the walk's own survival)), so the
+ * sum's mean is ∫ T σa Le dt to the segment's end; beyond a real collision it is the scattered paths'. */
 #ifdef EMISSION
 #define TRACK_EMISSION_PARAM , NV_PRIVATE vec3* emitted
 #define TRACK_EMISSION_ARG(x) , x
@@ -153,9 +122,8 @@ static inline tracking_walk tracking_walk_begin(NV_CONSTANT const medium_params*
   return w;
 }
 
-/* Spends the majorant optical depth `tau` from w->t on (see "the budget" above). 1: w->t is the
- * next tentative collision, w->bar its σ̄. 0: the walk left [t0, t1] first; the DDA's status bits
- * (non-finite ray, spent budget) go to *status. */
+/* Spends the majorant optical depth `tau` from w->t on ("the budget" above). 1: w->t is the next
+ * tentative collision, w->bar its σ̄. 0: the walk left [t0, t1]; DDA status bits go to *status. */
 static inline int tracking_walk_step(NV_PRIVATE tracking_walk* w, NV_GLOBAL const float* cells, float tau,
                                      NV_PRIVATE uint* status) {
   for (;;) {
@@ -179,12 +147,10 @@ static inline int tracking_walk_step(NV_PRIVATE tracking_walk* w, NV_GLOBAL cons
   }
 }
 
-/* Both walks start at the segment's entry: o + t·d becomes their origin and the walk's parameter
- * s = t' − t starts at 0. Stepping t itself, the steps would be added to the distance from the
- * ray's origin: a camera 10⁶ units away has an ulp of 0.06 there, so steps of 1/σ̄ below half of
- * it round back to t and, where the medium is empty under its majorant, the walk stands still
- * until its cap (tests/render/tracking_far_test.cpp). From the entry, s grows from 0 in steps it
- * can hold; a collision is reported as t + s. */
+/* Both walks start at the segment's entry o + t·d, their parameter s = t' − t growing from 0 in
+ * steps it can hold; a collision is reported as t + s. Stepping t itself, a camera 10⁶ units away has
+ * an ulp of 0.06 there: steps of 1/σ̄ below half of it round back to t, and in a medium empty under its
+ * majorant the walk stands still until its cap (tests/render/tracking_far_test.cpp). */
 static inline vec3 tracking_entry(vec3 o, vec3 d, float t) { return vec3_madd(o, d, t); }
 
 /* Walks o + t·d (index-space origin and direction; t is the world-space ray parameter because d is
@@ -268,9 +234,8 @@ static inline int tracking_delta(KERNEL_CONTEXT_PARAM, vec3 o, vec3 d, float t, 
 }
 
 /* Russian roulette on a ratio-tracked transmittance (pbrt-v4's TraceTransmittance): once every
- * channel is below `below`, the walk ends with probability q = 3/4 and survives with Tr / (1 − q),
- * so the estimate keeps its expectation, (1 − q)·Tr/(1 − q) = Tr, while a ray that has crossed a
- * few mean free paths stops paying for density lookups whose product it barely uses. */
+ * channel is below `below`, end with probability q = 3/4, else go on with Tr/(1 − q): unbiased,
+ * (1 − q)·Tr/(1 − q) = Tr, and a ray past a few mean free paths stops paying for lookups. */
 #define TRACKING_ROULETTE_Q 0.75f
 
 /* Ratio-tracking estimate of the transmittance along o + t·d over [t, t_max]; `roulette_below` > 0

@@ -14,7 +14,7 @@
 // Scene or DenseGrid edited after loading, as a caller of the library can. Caps: an over-dense
 // scene reaches the tracking cap without help (one test, and tests/cli/status_cli_test.cpp); the
 // rest shrink the caps at build time with ClRuntime::extraBuildOptions (-D NARVAL_TRACKING_MAX_STEPS,
-// -D NARVAL_DDA_BUDGET; tracking.h and majorant.h derive the defaults). Host-side checks of the same
+// -D NARVAL_DDA_BUDGET; tracking.h and majorant_dda.h derive the defaults). Host-side checks of the same
 // code paths: tests/unit/status_word_host_test.cpp.
 #include <gtest/gtest.h>
 
@@ -266,7 +266,7 @@ TEST(StatusWord, RatioTrackingCapRaisesIterationCap) {
   EXPECT_EQ(nonFinite(r.image), 0u);
 }
 
-// The real-time kernels' only open-ended loop is the DDA under every march (majorant.h; all other
+// The real-time kernels' only open-ended loop is the DDA under every march (majorant_dda.h; all other
 // loops run to scene parameters). With its budget forced to 1 iteration, a walk yields its first
 // segment and then stops short of t_end, which flags STATUS_ITERATION_CAP. A uniform 8³ grid gets
 // 8³ majorant cells (chooseMajorantResolution), so every view ray through the box crosses ≥ 2 cells

@@ -709,6 +709,16 @@ TEST_F(SceneFiles, ShippedScenesParse) {
   // A key light from the upper left front.
   EXPECT_EQ(cloud.primitives[2].materialName, "key");
 
+  // cloud_sun.json: the same grid, droplets with the Mie phase function, under a sun 0.53° wide.
+  const Scene sun = parseScene(readFile(scenes / "cloud_sun.json"), scenePath());
+  EXPECT_TRUE(sun.warnings.empty());
+  EXPECT_EQ(sun.materials[1].path, cloud128);
+  EXPECT_EQ(sun.materials[1].phase, PHASE_MIE);
+  EXPECT_EQ(sun.materials[1].phaseParameter, 20.0f);
+  EXPECT_EQ(sun.primitives[0].type, PrimitiveType::Light);
+  EXPECT_EQ(sun.primitives[0].lightKind, LIGHT_DISTANT);
+  EXPECT_EQ(sun.primitives[0].lightParameter, 0.53f);
+
   // listing_4_1.json is Listing 4.1 with only the grid's path changed.
   EXPECT_EQ(json::parse(readFile(scenes / "listing_4_1.json")), json::parse(listing41Json("data/cloud_128.vdb")));
   EXPECT_TRUE(parseScene(readFile(scenes / "listing_4_1.json"), scenePath()).warnings.empty());

@@ -127,7 +127,7 @@ TEST(StatusWordHost, MajorantBelowExtinctionIsANegativePdf) {
   }
 }
 
-// ---- majorant.h: the DDA's budget and its two bits --------------------------------------------
+// ---- majorant_dda.h: the DDA's budget and its two bits --------------------------------------------
 
 majorant_grid_params gridParams(int cx, int cy, int cz, float sx, float sy, float sz) {
   majorant_grid_params p{};
@@ -138,7 +138,7 @@ majorant_grid_params gridParams(int cx, int cy, int cz, float sx, float sy, floa
   return p;
 }
 
-// The budget's derivation (majorant.h, MAJORANT_DDA_BUDGET): a walk uses at most
+// The budget's derivation (majorant_dda.h, MAJORANT_DDA_BUDGET): a walk uses at most
 // nx + ny + nz − 1 iterations of majorant_iter_next's loop (counted as budget spent), 4 below the
 // budget. Checked on 20000 random rays per grid (origins inside and outside the box, lines through
 // it, directions with some components exactly 0, segments ending inside or beyond it) over grids

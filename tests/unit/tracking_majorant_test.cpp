@@ -100,7 +100,7 @@ TEST(TrackingMajorantBudget, AlongAnAxisAcrossAnEmptyCell) {
 
 // A start exactly on a face: at x = 1 going +x the walk starts in cell 1 (empty), so τ = 2M is
 // spent in cell 2 at rate 4M: t = 1 + 0.5 = 1.5 (the point x = 2.5). At x = 2 going −x it starts in
-// cell 1 too (the cell the ray enters, majorant.h), then cell 0 at rate 2M: τ = M → t = 1 + 0.5 =
+// cell 1 too (the cell the ray enters, majorant_dda.h), then cell 0 at rate 2M: τ = M → t = 1 + 0.5 =
 // 1.5 (x = 0.5); starting in cell 2 instead would have given t = 0.25.
 TEST(TrackingMajorantBudget, StartOnACellFace) {
   const medium_params m = handMedium(4, 1, 1);
@@ -113,7 +113,7 @@ TEST(TrackingMajorantBudget, StartOnACellFace) {
 
 // Zero direction components. 2×2×1 cells, value(i, j) = {1, 3, 0, 2}[i + 2j].
 // - d = (1, 0, 0) at y = 1 exactly, inside the face between rows j = 0 and j = 1: the walk follows
-//   the upper row (majorant.h), values 0 then 2: τ = M → t = 1 + 0.5 = 1.5. (The lower row, 1 then
+//   the upper row (majorant_dda.h), values 0 then 2: τ = M → t = 1 + 0.5 = 1.5. (The lower row, 1 then
 //   3, would give t = 1.)
 // - d = (0.6, 0.8, 0) from (0, 0, 0.5): x = 0.6t reaches 1 at t = 5/3, y = 0.8t reaches 1 at 1.25 and
 //   2 at 2.5. Cells: (0,0) value 1 on [0, 1.25], (0,1) value 0 on [1.25, 5/3], (1,1) value 2 on
