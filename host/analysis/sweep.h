@@ -1,15 +1,11 @@
-// sweep.h: speed against perceptual error over one path-tracing parameter (dissertation ch. 5,
-// Tables 5.1 and 5.2, Figs. 5.4 and 5.8). A sweep renders a scene at several values of spp or
-// bounces, largest first, times each render, and compares each with a reference (the largest
-// value's render, or an image the caller supplies) under the scene's display transform.
+// sweep.h: speed against perceptual error over spp or bounces (dissertation ch. 5, Tables 5.1 and 5.2, Figs.
+// 5.4 and 5.8): timed renders at several values, largest first, each compared under the scene's display
+// transform with a reference (the largest value's render, or a supplied image). The renderer is a parameter
+// (`narval sweep` passes renderPathtrace), so the logic is tested on the host without OpenCL.
 //
-// Every render uses the scene's seed. The path tracer's random numbers are keyed by sample index, so
-// an n-spp render is exactly the mean of the first n samples of the N-spp reference: its ΔE measures
-// a variance of σ²(1/n − 1/N) rather than the σ²/n of an independent ground truth (independent seeds
-// would give σ²(1/n + 1/N)); the difference is small when N ≫ n, as in the dissertation's 10× steps.
-//
-// The renderer is passed in as a function, so the sweep logic (order, reference row, speed-up,
-// tables, figure) is tested on the host without OpenCL; `narval sweep` passes renderPathtrace.
+// All renders use the scene's seed and sample-keyed random numbers, so an n-spp render is the mean of the
+// N-spp reference's first n samples: its ΔE measures σ²(1/n − 1/N), not σ²/n against an independent ground
+// truth (independent seeds: σ²(1/n + 1/N)); small when N ≫ n, as in the dissertation's 10× steps.
 #pragma once
 
 #include <functional>
@@ -30,9 +26,8 @@ enum class SweepParameter { Spp, Bounces };
 // "spp" / "bounces": the parameter's name in files, tables and labels.
 const char* sweepParameterName(SweepParameter p);
 
-// "10,100,1000" -> {10, 100, 1000}. Values must be positive integers (spaces around them are
-// allowed) and distinct. Throws InputError "OPTION: expected a comma-separated list of positive
-// integers, got 'TEXT'" (or "OPTION: VALUE is listed twice").
+// "10,100,1000" -> {10, 100, 1000}: distinct positive integers (spaces allowed). InputError "OPTION: expected
+// a comma-separated list of positive integers, got 'TEXT'" or "OPTION: VALUE is listed twice".
 std::vector<int> parseSweepList(const std::string& text, const std::string& option);
 
 // The EXR name of one value: spp_00010.exr, bounces_0035.exr (wider values keep all digits).
@@ -68,8 +63,7 @@ struct SweepResult {
   DisplaySettings display;
   std::string referenceFile;      // the external reference, or "" (the first row is the reference)
   ImageRGB referenceImage;        // what every row was compared with
-  // The value whose render time is the speed-up's numerator: the reference's value, or with an
-  // external reference (whose render time is unknown) the largest value rendered.
+  // The value timing the speed-up's numerator: the reference's, or with an external one the largest rendered.
   int speedupBaseline = 0;
   std::vector<SweepRow> rows;     // descending values
 };
@@ -83,31 +77,25 @@ void checkSweepReference(const Scene& scene, const ImageRGB& reference, const st
 // The comparison's display transform: the scene's exposure and tone mapping.
 DisplaySettings sceneDisplaySettings(const Scene& scene);
 
-// Renders `scene` (validated) with spec.parameter set to each value, largest first, the other
-// parameter as the scene has it. `onRow` is called after each render and its comparison (to save
-// the EXR at once, report progress). An external reference must be the scene's size (InputError
-// otherwise, before anything is rendered).
+// Renders `scene` (validated) at each spec.parameter value, largest first, the other as the scene has it; `onRow`
+// runs after each render and comparison (save the EXR, report progress). Bad external reference: InputError first.
 SweepResult runSweep(const Scene& scene, const SweepSpec& spec, const SweepRenderer& render,
                      const std::function<void(const SweepRow&)>& onRow = {});
 
-// The table: header "value,seconds,speedup,mean_dE76,jnd76_pct,mean_dE2000,jnd2000_pct", one line
-// per row in the rows' order.
+// The table: header "value,seconds,speedup,mean_dE76,jnd76_pct,mean_dE2000,jnd2000_pct", then the rows.
 std::string sweepCsv(const SweepResult& r);
 // {parameter, scene, device, fixed: {NAME: value}, width, height, seed, display, reference,
 // speedup_baseline, rows: [{value, seconds, speedup, mean_dE76, jnd76_pct, mean_dE2000,
 // jnd2000_pct, reference, exr (sweepFileName), ...}]}.
 nlohmann::ordered_json sweepJson(const SweepResult& r);
 
-// The figure strip (Figs. 5.4, 5.8) on a white page: a title, then one column per row (an external
-// reference gets a column of its own first) with its label ("10000 spp") and speed-up above, the
-// displayed render, the ΔE76 heat map (0..10, with legend) captioned with the mean ΔE76, and the JND
-// map captioned with its percentage. Renders narrower than 160 px are enlarged by a whole factor
-// (pixels repeated; maps drawn at that size); a strip wider than `maxWidth` is shrunk (maps drawn at
-// full size, then box-filtered, so a JND map's red shows the share of pixels over the JND).
+// The figure strip (Figs. 5.4, 5.8) on white: a title, then per row (an external reference first) its label
+// ("10000 spp") and speed-up, the displayed render, the ΔE76 heat map (0..10, legend) captioned with the
+// mean, and the JND map with its percentage. Renders under 160 px wide are enlarged by a whole factor (pixels
+// repeated, maps drawn at that size); a strip over `maxWidth` shrinks (maps box-filtered: red = share over JND).
 ImageRGB8 sweepFigure(const SweepResult& r, int maxWidth = 4000);
 
-// Box-filtered resize of an 8-bit picture (area average when shrinking; whole-factor enlargements
-// repeat pixels exactly).
+// Box-filtered resize of an 8-bit picture (area average shrinking; whole-factor enlargement repeats pixels).
 ImageRGB8 resizeImage(const ImageRGB8& src, int width, int height);
 
 }  // namespace narval

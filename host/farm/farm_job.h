@@ -1,9 +1,7 @@
-// farm_job.h: work split into independent tasks and one final step, written as a job for a
-// scheduler. Two kinds: a path-traced render split into sample ranges (renderFarmJob: each task
-// `narval render --samples A:B` into JOB/parts, then `narval merge`, bit for bit the single
-// render; render/render_merge.h), and a sweep's renders (sweep_command.cpp: one render per value,
-// then `narval sweep --collect`). The job folder holds the scripts (writeFarmFiles), the logs, and
-// for renders the parts.
+// farm_job.h: independent tasks plus one final step, written as a job for a scheduler: a path-traced render split
+// into sample ranges (renderFarmJob: tasks `narval render --samples A:B` into JOB/parts, then `narval merge`, bit
+// for bit the single render; render/render_merge.h), or a sweep's renders (sweep_command.cpp: one per value, then
+// `narval sweep --collect`). JOB holds the scripts (writeFarmFiles), the logs and, for renders, the parts.
 #pragma once
 
 #include <functional>
@@ -25,9 +23,8 @@ struct FarmTask {
   std::string label;              // its name in reports: "samples [0, 3)", "spp 100"
 };
 
-// An Open Job Description form of a job whose tasks differ only in their task parameters, with
-// the files as PATH job parameters (a Deadline Cloud submission maps them to its workers' storage).
-// Jobs without one get a template that runs task.sh's commands as an embedded file.
+// An Open Job Description form for a job whose tasks differ only in task parameters, files as PATH job
+// parameters (Deadline Cloud maps them to its workers' storage); without one, the template embeds task.sh.
 struct OpenJdForm {
   nlohmann::json pathParameters;   // PATH parameter definitions (no defaults: OpenJD allows none absolute)
   std::vector<std::pair<std::string, std::string>> pathValues;  // their values for this job
@@ -49,9 +46,8 @@ struct FarmJob {
   // output makes it run again); whether the final output is this job's.
   std::function<bool(int task)> taskDone;
   std::function<bool()> finalDone;
-  // Whether task i's output, not done, may stay for the task to continue (a render part with the
-  // task's key and first sample, fewer samples: the task resumes it); null: never. runFarm removes
-  // any other output before the task runs again.
+  // Whether task i's output, not done, may stay for the task to resume (a render part with the task's
+  // key and first sample, fewer samples); null: never. runFarm removes any other output before the rerun.
   std::function<bool(int task)> taskResumable;
   std::function<OpenJdForm()> openJd;  // null: the generic template
 
@@ -61,12 +57,10 @@ struct FarmJob {
   std::string finalTimePath() const;     // JOB/logs/final.time
 };
 
-// A path-traced render of `scene` (absolute) with `renderArgs` (render's flags: --set, --seed, ...),
-// `spp` samples split into `tasks` ranges [iN/K, (i+1)N/K) (contiguous, uneven by at most one
-// sample), parts in JOB/parts/part_I.exr, merged into `output`; `renderKey` is the scene's with
-// those flags (render_exr.h), what a finished part must carry. Every task renders with --resume,
-// so a part left by an interrupted task (Ctrl-C, or --write-partial-images in `renderArgs` before
-// a kill) is continued rather than started again.
+// A path-traced render of `scene` (absolute) with `renderArgs` (--set, --seed, ...): `spp` samples in `tasks`
+// ranges [iN/K, (i+1)N/K) (contiguous, uneven by at most one), parts JOB/parts/part_I.exr merged into
+// `output`; finished parts carry `renderKey` (render_exr.h: the scene's with those flags). Tasks use
+// --resume, continuing a part an interrupted task left (Ctrl-C, or a kill with --write-partial-images).
 FarmJob renderFarmJob(const std::string& narval, const std::string& scene, const std::vector<std::string>& renderArgs,
                       int spp, int tasks, const std::string& jobDir, const std::string& output,
                       const std::string& renderKey, const std::string& name);
@@ -74,14 +68,12 @@ FarmJob renderFarmJob(const std::string& narval, const std::string& scene, const
 // Tasks whose output is not (yet) what it must be; ascending.
 std::vector<int> missingTasks(const FarmJob& job);
 
-// Writes the job's files for `scheduler` into job.jobDir (made if missing) and returns their paths:
-// - slurm and local: task.sh (one task by index: a case table of the commands) and final.sh, which
-//   record their times; slurm adds tasks.sbatch (a job array over the tasks), final.sbatch and
-//   submit.sh, which submits the array and then the final job with --dependency=afterok:ARRAY;
-//   local adds run.sh (every task in turn, then the final step);
-// - openjd: template.json (jobtemplate-2023-09: a step over the tasks, the final step depending on
-//   it) and, for a job with an OpenJdForm, Deadline's parameter_values.json: the folder is a
-//   Deadline Cloud job bundle.
+// Writes the job's files for `scheduler` into job.jobDir (made if missing); returns their paths. slurm and
+// local: task.sh (one task by index: a case table of the commands) and final.sh, recording their times;
+// slurm adds tasks.sbatch (a job array), final.sbatch and submit.sh (the array, then the final job with
+// --dependency=afterok:ARRAY); local adds run.sh (every task, then the final step). openjd: template.json
+// (jobtemplate-2023-09: a step over the tasks, the final step after it) and, with an OpenJdForm,
+// Deadline's parameter_values.json: the folder is a Deadline Cloud job bundle.
 std::vector<std::string> writeFarmFiles(const FarmJob& job, Scheduler scheduler);
 
 // `openjd run JOB/template.json [-p NAME=VALUE...]`: the whole job on this machine.

@@ -30,27 +30,23 @@ struct ExrUintChannel {
   std::vector<uint32_t> values;
 };
 
-// A header attribute, stored with the OpenEXR type of its value: string, int, float, double or
-// stringvector (what other tools read typed: pbrt-v4's samplesPerPixel is an int).
+// A header attribute, stored with its value's OpenEXR type (tools read them typed: pbrt-v4's samplesPerPixel).
 struct ExrAttribute {
   using Value = std::variant<std::string, int, float, double, std::vector<std::string>>;
   std::string name;
   Value value;
 };
 
-// 32-bit float linear RGB EXR with `attributes` in the header; `extra` UINT channels are stored
-// beside R, G and B (viewers show them as layers).
-// Written to a temporary file beside `path` and renamed, so a failure never leaves a broken file
-// and never touches an existing `path`; it throws std::runtime_error "PATH: cannot write: REASON".
+// 32-bit float linear RGB EXR with `attributes` in the header and `extra` UINT channels beside R, G and B
+// (viewers show them as layers). Written to a temporary file beside `path`, then renamed: a failure never
+// leaves a broken file or touches an existing `path`; it throws std::runtime_error "PATH: cannot write: REASON".
 void writeExr(const std::string& path, const ImageRGB& image, const std::vector<ExrAttribute>& attributes = {},
               const std::vector<ExrUintChannel>& extra = {});
-// Reads R, G and B as 32-bit float (half or uint channels are converted) from any data window;
-// the result is the data window's size. A missing, unreadable or corrupt file, or a missing R, G or
-// B channel, throws InputError "PATH: what".
+// R, G and B as 32-bit float (half or uint channels converted), the data window's size (any window). A
+// missing, unreadable or corrupt file, or a missing R, G or B channel, throws InputError "PATH: what".
 ImageRGB readExr(const std::string& path);
-// The attributes of an EXR header that writeExr can write, by name, as text: strings as they are,
-// ints in decimal, floats and doubles in the fewest digits that read back, string vectors one
-// element per line; throws InputError like readExr.
+// The header attributes writeExr can write, by name, as text: strings as they are, ints in decimal, floats
+// and doubles in the fewest digits that read back, string vectors one element per line; throws as readExr.
 std::map<std::string, std::string> readExrAttributes(const std::string& path);
 // The named channels as 32-bit float, width*height values each in the data window's size; a
 // missing channel throws InputError "PATH: no NAME channel (channels: ...)", like readExr.
@@ -62,8 +58,7 @@ struct ExrHeader {
 };
 ExrHeader readExrHeader(const std::string& path);
 // R, G and B (as readExr), the named UINT channels (as readExrUintChannels) and the attributes (as
-// readExrAttributes) from one opening of the file and one read of its pixels: what `narval merge`
-// reads of each part.
+// readExrAttributes) from one opening and one pixel read: what `narval merge` reads of each part.
 struct ExrContents {
   ImageRGB image;
   std::vector<ExrUintChannel> uints;
@@ -83,9 +78,8 @@ struct ImageRGB8 {
 // Atomic RGB8 PNG write of an 8-bit picture.
 void writePng8(const std::string& path, const ImageRGB8& image);
 
-// Display transform (display_transform.h): multiply by 2^exposure, tone map, clamp to [0, 1],
-// sRGB transfer, round to 8 bit; NaN shows as 0, +inf as 255. RGB8 PNG with an sRGB chunk, written
-// atomically like writeExr. Cannot create or write the file: std::runtime_error naming `path`.
+// Display transform (display_transform.h): 2^exposure, tone map, clamp to [0, 1], sRGB transfer, round to 8
+// bit (NaN: 0, +inf: 255), into an sRGB-chunk RGB8 PNG written atomically; failing: std::runtime_error naming `path`.
 void writePng(const std::string& path, const ImageRGB& image, float exposureStops, ToneMapping tm);
 
 }  // namespace narval

@@ -1,10 +1,8 @@
-// light_cache.h: the light-transmittance cache of the real-time kernels on the device
-// (kernels/shared/light_cache.h holds the math and the layout; kernels/light_cache.cl builds it).
-// Per light, a grid of nodes over the medium's box holding the column density to the light; both
-// real-time kernels read it instead of marching shadow rays. Built once and kept: update() compares
-// what each slab was built from (the medium, the grid, the layout, the shadow step count, that
-// light) and rebuilds only the slabs whose inputs changed, so frames and camera moves rebuild
-// nothing, and moving one light rebuilds its slab alone.
+// device_light_cache.h: the real-time kernels' light-transmittance cache on the device (math and layout:
+// kernels/shared/light_cache.h; kernels/light_cache.cl builds it): per light, a grid of nodes over the
+// medium's box holding the column density to the light, read instead of marching shadow rays. update()
+// rebuilds only the slabs whose inputs (medium, grid, layout, shadow step count, that light) changed, so
+// frames and camera moves rebuild nothing and moving one light rebuilds its slab alone.
 #pragma once
 
 #include <cstdint>
@@ -19,16 +17,13 @@
 
 namespace narval {
 
-// renderer.lightCache.resolution "auto" (kLightCacheAuto): cells on the longest axis, chosen by
-// measurement (bench/realtime_tuning.sh; bench/RESULTS.md).
+// renderer.lightCache.resolution "auto": longest-axis cells, measured (bench/realtime_tuning.sh; bench/RESULTS.md).
 constexpr int kLightCacheAutoResolution = 64;
 
-// The cache's layout for `resolution` cells along the longest world-space axis of the medium's
-// box (kLightCacheAuto: kLightCacheAutoResolution), the other axes in proportion (at least one
-// cell each), nodes = cells + 1 per axis. nx = 0 (no cache) for resolution 0 or no medium.
-// With kLightCacheAuto the resolution is halved until every light's slabs fit in `maxAllocBytes`
-// (the device's largest allocation); an explicit resolution is kept (the allocation then fails
-// with a message naming renderer.lightCache.resolution).
+// The cache's layout: `resolution` cells on the medium box's longest world-space axis, the others in
+// proportion (at least one), nodes = cells + 1 per axis; nx = 0 (no cache) for resolution 0 or no medium.
+// kLightCacheAuto starts at kLightCacheAutoResolution, halving until every light's slabs fit `maxAllocBytes`
+// (the device's largest allocation); an explicit one is kept (update() then throws).
 node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes = SIZE_MAX);
 
 // The column densities of every light's slab computed on the host with the shared header (what the
@@ -38,15 +33,14 @@ std::vector<float> buildLightCacheOnHost(const DeviceScene& ds, const grid_view*
 
 class DeviceLightCache {
  public:
-  // Brings the cache of `layout` (nx > 0) up to date for the scene on `dev` and the shadow rays
-  // of `march`; a no-op when nothing it was built from changed. Throws InputError when the cache exceeds the device's largest allocation (naming
-  // `sceneFile` and renderer.lightCache.resolution).
+  // Brings the cache of `layout` (nx > 0) up to date for the scene on `dev` and the shadow rays of
+  // `march`; a no-op when nothing it was built from changed. Throws InputError (naming `sceneFile` and
+  // renderer.lightCache.resolution) when the cache exceeds the device's largest allocation.
   void update(ClRuntime& rt, const DeviceSceneBuffers& dev, const march_params& march, const node_grid_params& layout,
               const std::string& sceneFile);
   const cl::Buffer& buffer() const { return buffer_; }
   int slabsBuilt() const { return slabsBuilt_; }  // light slabs built over this object's life
-  // Their launches' time by profiling events, as the frames are timed (the program build and the
-  // driver's compile on a first launch are not in it).
+  // Launch time by profiling events, as frames are timed (no program build or first-launch driver compile).
   double buildMs() const { return buildMs_; }
   size_t bytes() const { return bytes_; }
   uint32_t status() const { return status_; }     // STATUS_* bits the builds met

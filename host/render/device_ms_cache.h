@@ -1,8 +1,7 @@
-// ms_cache.h: the ray marcher's multiple-scattering cache on the device (kernels/shared/ms_cache.h
-// holds the math; kernels/ms_cache.cl adds paths to it). Per node of a grid over the medium's box,
-// the running mean of paths started there by the path tracer's own code. Progressive: refine()
-// adds a number of paths per node (a viewer can call it once per frame); it starts over only when
-// what the paths depend on changes (medium, grid, lights, bounces, seed, background, layout).
+// device_ms_cache.h: the ray marcher's multiple-scattering cache on the device (kernels/shared/ms_cache.h:
+// the math; kernels/ms_cache.cl adds paths): per node, the running mean of paths started there by the path
+// tracer's own code. Progressive: refine() adds paths per node (a viewer may call it every frame), starting
+// over only when the medium, grid, lights, bounces, seed, background or layout change.
 #pragma once
 
 #include <string>
@@ -17,18 +16,15 @@ namespace narval {
 
 class DeviceMsCache {
  public:
-  // Brings the cache to at least `targetPaths` paths per node for the scene on `dev` and
-  // params.grid (nx > 0), in launches of at most `pathsPerLaunch` paths per node; starts over
-  // when the scene changed. Throws InputError when the cache exceeds the device's largest
-  // allocation (naming `sceneFile` and renderer.raymarch.msCache.resolution).
-  // With allocation.perceptual (view layout; ms_cache_allocation.h) every node first takes the
-  // pilot, then each column its own budget, averaging allocation.meanPaths: `targetPaths` then
-  // counts towards that mean (paths() reaches it when every budget is spent).
+  // Brings the cache to at least `targetPaths` paths per node for the scene on `dev` and params.grid (nx > 0),
+  // in launches of at most `pathsPerLaunch`, starting over when the scene changed; InputError (naming
+  // `sceneFile` and renderer.raymarch.msCache.resolution) when over the device's largest allocation. With
+  // allocation.perceptual (view layout; ms_cache_allocation.h) nodes take the pilot, then columns their budgets
+  // (averaging allocation.meanPaths, towards which `targetPaths` counts; paths() reaches it once all are spent).
   void refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params, int targetPaths,
               int pathsPerLaunch, const std::string& sceneFile, const MsCacheAllocation& allocation = {});
-  // What the march reads: the running means, or with the view layout's filter on
-  // (params.filter > 0; kernels/shared/ms_cache_filter.h) their filtered copy, twiced
-  // when params.filter_twicing is set.
+  // What the march reads: the running means or, with the view layout's filter (params.filter > 0;
+  // kernels/shared/ms_cache_filter.h), their filtered copy, twiced when params.filter_twicing is set.
   const cl::Buffer& buffer() const { return twicingOn_ ? twiced_ : filterOn_ ? filtered_ : buffer_; }
   const cl::Buffer& means() const { return buffer_; }  // the running means, unfiltered
   int paths() const;                               // paths per node so far (allocated: their mean, pro rata)
@@ -43,13 +39,13 @@ class DeviceMsCache {
  private:
   void addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params, int targetPaths,
                 int pathsPerLaunch);
+  // The filtered copy, when the paths or settings changed.
   void filter(ClRuntime& rt, const ms_cache_params& params);
-  // The perceptual allocation (ms_cache.cpp): the budgets, once the pilot is done, and the launch
-  // index the caller's `targetPaths` stands for under them.
+  // The perceptual allocation (ms_cache.cpp): budgets after the pilot, and the launch index `targetPaths` maps to.
   void setBudgets(ClRuntime& rt, const ms_cache_params& params);
   int allocatedLaunches(int targetPaths) const;
   // The majorant grid the paths walk into pathScene and majorantBuf_ (ms_cache.cpp).
-  void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);  // the filtered copy, when the paths or settings changed
+  void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);
 
   std::string key_;
   AllocationSite site_;  // what an allocation failure names (the scene file and key)

@@ -1,8 +1,6 @@
-// render_exr.h: what a render's EXR carries besides its pixels: header attributes that name the
-// render (algorithm, spp, seed, scene, device, status, a key of the settings), and for the path
-// tracer its sample range and exact accumulator (render/accumulator.h), so that `narval render
-// --resume` continues a render to more samples, and `narval merge` adds renders of disjoint sample
-// ranges, with the bits of one uninterrupted render.
+// render_exr.h: a render's EXR beyond pixels: attributes naming it (algorithm, spp, seed, scene, device,
+// status, settings key) and, for the path tracer, its sample range and exact accumulator (render/accumulator.h),
+// so `narval render --resume` and `narval merge` (disjoint ranges) give the bits of one uninterrupted render.
 #pragma once
 
 #include <string>
@@ -15,18 +13,15 @@
 
 namespace narval {
 
-// Hex FNV-1a of the scene as rendered (Scene::document), less the settings that do not change the
-// path tracer's samples: renderer spp, HDR, toneMapping, exposure, raymarch.*, lobe.* and
-// camera.speed. Equal keys: the same samples, sample index for sample index.
+// Hex FNV-1a of the scene as rendered (Scene::document) less what leaves the path tracer's samples alone
+// (renderer spp, HDR, toneMapping, exposure, raymarch.*, lobe.*, camera.speed): equal keys, equal samples.
 std::string renderKey(const Scene& scene);
 
-// The command line narval was started with, shell-quoted (main records it once; "" until then):
-// what a render's EXR names as the command that made it.
+// The shell-quoted command line (main records it once; "" until then), named in a render's EXR.
 void recordCommandLine(int argc, const char* const* argv);
 const std::string& recordedCommandLine();
 
-// What names a render besides its statistics: from the scene when it is rendered, from a part's
-// header when parts are merged (render_merge.h).
+// What names a render besides its statistics: from the scene, or a part's header when merging (render_merge.h).
 struct RenderIdentity {
   uint32_t seed = 0;
   std::string scene, renderKey;  // Scene::sourcePath; renderKey(scene)
@@ -36,15 +31,12 @@ struct RenderIdentity {
 };
 RenderIdentity renderIdentity(const Scene& scene);
 
-// The header attributes of a render's EXR, numbers typed as numbers:
-// - pbrt-v4's, which image tools read: renderTimeSeconds (float), samplesPerPixel (int);
-// - OpenEXR's standard capDate ("YYYY:MM:DD hh:mm:ss", local time) and utcOffset (float seconds,
-//   UTC = local time + utcOffset);
-// - narval's: algorithm, spp, bounces, seed, scene, device, seconds, status, render_key, majorant,
-//   majorant_resolution (what --resume checks), sample_begin and sample_end (the path tracer's
-//   samples [begin, end), what `narval merge` tiles), exposure and tone_mapping (the scene's display
-//   transform, which `narval compare` applies by default), version, command_line and overrides
-//   (the --set strings, a string vector).
+// The header attributes of a render's EXR, numbers typed as numbers: pbrt-v4's renderTimeSeconds (float)
+// and samplesPerPixel (int), which image tools read; OpenEXR's capDate ("YYYY:MM:DD hh:mm:ss", local) and
+// utcOffset (float s; UTC = local + utcOffset); narval's algorithm, spp, bounces, seed, scene, device,
+// seconds, status, render_key, majorant, majorant_resolution (what --resume checks), sample_begin and
+// sample_end (samples [begin, end), what `narval merge` tiles), exposure and tone_mapping (the display
+// transform `narval compare` applies by default), version, command_line, overrides (--set strings, a vector).
 std::vector<ExrAttribute> renderAttributes(const RenderStats& stats, const RenderIdentity& identity);
 
 // Writes result.image to `path` (atomically) with renderAttributes and, for the path tracer, the
@@ -73,10 +65,9 @@ void loadAccumulatorWords(RenderPart& part);
 // header: what a farm task must have left (a part, or one of a sweep's renders).
 bool renderCovers(const std::string& path, const std::string& renderKey, int begin, int end);
 
-// Reads the accumulator of an earlier path-traced render of the same scene from `path` for
-// --resume of samples [sampleBegin, sampleBegin + scene.renderer.spp). InputError "PATH:
-// ATTRIBUTE: ..." when the file is not a resumable narval render, was rendered from other settings
-// (renderKey), starts at another sample or has more samples than asked for.
+// The accumulator of an earlier path-traced render of the scene at `path`, to --resume samples
+// [sampleBegin, sampleBegin + scene.renderer.spp). InputError "PATH: ATTRIBUTE: ..." when it is not a
+// resumable narval render, has another renderKey, starts at another sample or holds more than asked for.
 AccumulatorState readAccumulator(const std::string& path, const Scene& scene, int sampleBegin);
 
 }  // namespace narval

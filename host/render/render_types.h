@@ -1,5 +1,4 @@
-// render_types.h: what every renderer takes (options) and gives back (image + statistics,
-// render_stats.h).
+// render_types.h: what every renderer takes (options) and gives back (image + statistics, render_stats.h).
 #pragma once
 
 #include <atomic>
@@ -24,22 +23,18 @@ struct RenderOptions {
   // pathtrace: the first sample index (--samples A:B); the render adds scene.renderer.spp samples
   // from there. Samples are numbered per pixel, so [A, B) of one render are those of any other.
   int sampleBegin = 0;
-  // pathtrace: continue from this state (same scene, size and seed; its begin is sampleBegin)
-  // instead of from zero.
+  // pathtrace: continue from this state (same scene, size and seed; its begin is sampleBegin), not zero.
   const AccumulatorState* resumeFrom = nullptr;
-  // pathtrace: the majorant delta and ratio tracking sample against (kernels/shared/tracking.h):
-  // "grid" (per cell of the majorant grid, walked by DDA), "global" (one σ̄ over the box), or "auto"
-  // (by device type, measured: render/majorant_options.h). Each is its own kernel build; both are
-  // unbiased and deterministic, with different random streams.
+  // pathtrace: the majorant of delta and ratio tracking (kernels/shared/tracking.h): "grid" (per cell, walked
+  // by DDA), "global" (one σ̄ over the box) or "auto" (by device type, measured: render/majorant_options.h).
+  // Each is its own kernel build; both are unbiased and deterministic, with different random streams.
   std::string majorant = "auto";
-  // Majorant grid cells along the grid's longest axis (chooseMajorantResolution); 0 = automatic
-  // (path tracer: pathtraceMajorantResolution; real-time kernels: kDefaultMajorantResolution). Also
-  // the real-time kernels' empty-space skipping granularity.
+  // Majorant grid cells on the longest axis (chooseMajorantResolution; real-time: the empty-space skip step);
+  // 0 = automatic (path tracer: pathtraceMajorantResolution, real-time: kDefaultMajorantResolution).
   int majorantResolution = 0;
-  // pathtrace: asked after every pass but the last whether to read the samples so far back; when
-  // it says yes, `snapshot` gets them as a partial result (image, accumulator, the stats so far,
-  // `interrupted` set), e.g. for a display server or --write-partial-images. Reading back between
-  // passes changes no pixel.
+  // pathtrace: asked after every pass but the last whether to read back the samples so far; if so,
+  // `snapshot` gets them as a partial result (image, accumulator, stats so far, `interrupted` set), e.g.
+  // for a display server or --write-partial-images. Reading back between passes changes no pixel.
   std::function<bool()> snapshotDue;
   std::function<void(const struct RenderResult&)> snapshot;
   // pathtrace: build with -DCOUNTERS and report collision and lookup counts in RenderStats.

@@ -28,11 +28,9 @@ struct Transform {
 enum class MaterialType { Emitter, Volume };
 enum class GridSpace { Unit, File };
 
-// A volume's emission (pbrt-v4's model, kernels/shared/emission.h): the medium emits σa(x)·Le(x)
-// per unit length, Le = color · scale · v(x) (Color: v from the grid `grid` of the volume's file,
-// or 1 without one) or scale · B((v(x) − temperatureOffset) · temperatureScale) (Blackbody: v from
-// the temperature grid `grid`, or the constant `temperature` in kelvin; B the blackbody colour of
-// host/colour/blackbody.h, nothing at or below 100 K).
+// A volume's emission (pbrt-v4's model; kernels/shared/emission.h): σa(x)·Le(x) per unit length, Le =
+// color · scale · v(x) (Color; v: grid `grid`, else 1) or scale · B((v(x) − temperatureOffset) · temperatureScale)
+// (Blackbody; v: temperature grid `grid`, else `temperature` K; B: host/colour/blackbody.h, 0 at or below 100 K).
 enum class EmissionKind { None, Color, Blackbody };
 struct Emission {
   EmissionKind kind = EmissionKind::None;
@@ -82,13 +80,10 @@ struct Camera {
   float speed = 1.0f;        // viewer navigation only
 };
 
-// How the density grid lives on the device (kernels/shared/grid.h): a 3D image read with the
-// hardware sampler, a float buffer filtered by hand (kernels/shared/grid.h's grid_trilinear), or
-// sparse 8³ bricks with an index table (the same filter, bit for bit; only bricks holding density
-// take memory: grids beyond one image or buffer). Auto: the buffer on CPU devices (faster than
-// PoCL's image sampler) and on devices without image support, the image elsewhere (GPUs filter in
-// hardware); timings in bench/RESULTS.md. Bricks, with a warning, when that choice cannot hold the
-// grid. render/device_grid.h resolves it. The kinds: kernels/shared/grid_storage_kinds.h.
+// How the density grid lives on the device (kernels/shared/grid.h, grid_storage_kinds.h): a 3D image
+// (hardware sampler), a float buffer (grid_trilinear), or sparse 8³ bricks (same filter, bit for bit; only
+// bricks holding density take memory). Auto, resolved with its reasons by render/device_grid.h: the buffer
+// on CPUs and without image support, else the image; Bricks, with a warning, when that cannot hold the grid.
 #define GRID_STORAGE_ENUMERATOR(name, cxx, define) cxx,
 enum class GridStorage { Auto, GRID_STORAGE_KINDS(GRID_STORAGE_ENUMERATOR) };
 #undef GRID_STORAGE_ENUMERATOR
@@ -102,19 +97,17 @@ enum class MultipleScattering { None, Octaves, Cache };
 // dissertation's), or exactly over the light's solid angle (kernels/shared/phase_polygon.h).
 enum class AreaLightPhase { Points, Exact };
 
-// How a rectangle light's shadow averages its K×K points (kernels/shared/march.h,
-// march_light_column): by each point's share of the light reaching a point, or of the light it
-// scatters towards the camera (the phase function too; the light cache then follows the camera).
+// How a rectangle light's shadow weights its K×K points (kernels/shared/march.h, march_light_column): by
+// the light reaching a point, or by that scattered to the camera (the light cache then follows the camera).
 enum class ShadowWeighting { Area, Phase };
 
-// What the cache's two moments (directional average R, first moment b) say about the
-// in-scattering in a direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear
-// expansion, or the HG lobe with those moments.
+// What the cache's two moments (directional average R, first moment b) say about the in-scattering in a
+// direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear expansion, or the HG lobe.
 enum class MsCacheClosure { Linear, Hg, Camera };
 // How the cache mixes its nodes (kernels/shared/ms_cache.h, "Interpolation").
 enum class MsCacheInterpolation { Geometric, Linear };
-// Where its nodes are: a grid over the medium's box, or columns over the image with nodes along
-// each column's optical depth from the camera (kernels/shared/ms_cache_view.h).
+// Its nodes: a grid over the medium's box, or image columns with nodes along their optical depth from the
+// camera (kernels/shared/ms_cache_view.h).
 enum class MsCacheLayout { Grid, View };
 // How the view layout spreads its paths over its columns: the same number each, or by what their
 // noise costs the eye (host/render/ms_cache_allocation.h).
@@ -130,8 +123,8 @@ struct MsCacheSettings {
   // The lights' unscattered light: added by the march (false) or held by the cache with the rest
   // (kernels/shared/ms_cache.h, "Direct"; closure "camera" or layout "view" only).
   bool direct = false;
-  // view: the filter over the nodes (kernels/shared/ms_cache_filter.h): σ_s in columns (0: off)
-  // and k, the standard errors by which a neighbour may differ before it loses weight.
+  // view: the node filter (kernels/shared/ms_cache_filter.h): σ_s in columns (0: off) and k, the
+  // standard errors by which a neighbour may differ before it loses weight.
   float filter = 0;
   float filterTolerance = 1;
   bool filterTwicing = false;  // the filter's residual filtered and added back (ms_cache_filter.h, "Twicing")
@@ -152,43 +145,36 @@ struct RaymarchSettings {
   float octaveScattering = 0.5f;  // a
   float octaveExtinction = 0.5f;  // b
   float octavePhase = 0.5f;       // c
-  // Early termination of the view march: it stops once every channel's transmittance is below
-  // this (kernels/shared/raymarch.h derives the error bound); 0 marches to the end.
+  // The view march stops once every channel's transmittance is below this (error bound: raymarch.h); 0: never.
   float minTransmittance = 1e-3f;
-  // Absent from the scene: Octaves when octaves > 1, else None (scenes from before the key).
+  // Absent from the scene: Octaves when octaves > 1, else None.
   MultipleScattering multipleScattering = MultipleScattering::None;
   MsCacheSettings msCache;
-  // A rectangle light is K×K points for the phase function and 1/d² (march_light_phase_sum in
-  // kernels/shared/march.h), costing K² phase evaluations per sample; 1 = its centre, the
-  // dissertation's point approximation. Its shadow is averaged over K×K points
-  // (march_light_column), which costs only the light cache's build.
+  // A rectangle light is K×K points for the phase and 1/d² (march.h, march_light_phase_sum: K² evaluations a
+  // sample; 1 = its centre, the dissertation's) and for its shadow (march_light_column: light cache build only).
   int areaLightSamples = 1;
   AreaLightPhase areaLightPhase = AreaLightPhase::Points;
   int shadowAreaSamples = 4;
   ShadowWeighting shadowWeighting = ShadowWeighting::Area;
 };
 
-// Next-event estimation in the path tracer (kernels/shared/light_select.h): a shadow ray to every
-// light at every scattering event, or to one light picked in proportion to its power or to its
-// estimated fluence over the medium (render/light_selection.h).
+// Next-event estimation (kernels/shared/light_select.h): a shadow ray to every light at each scattering
+// event, or to one picked by power or by estimated fluence over the medium (render/light_selection.h).
 enum class LightSampling { All, Power, Fluence };
 
 struct PathtraceSettings {
   LightSampling lightSampling = LightSampling::All;
-  // Ratio-tracked shadow rays play Russian roulette once their transmittance is below this in
-  // every channel (kernels/shared/tracking.h); 0 = never. pbrt-v4's threshold; it raises the
-  // efficiency on both clouds (bench/pathtrace_sampling.py, bench/RESULTS.md).
+  // Ratio-tracked shadow rays play Russian roulette below this transmittance in every channel (tracking.h);
+  // 0 = never. pbrt-v4's threshold; more efficient on both clouds (bench/pathtrace_sampling.py, bench/RESULTS.md).
   float shadowRoulette = 0.05f;
 };
 
 // The Lobe Estimator: the dissertation's Eq. 7, or the corrected estimator (kernels/shared/lobe.h).
 enum class LobeVariant { Eq7, Corrected };
 
-// What renders the scene (renderer.algorithm): the unbiased path tracer, or one of the real-time
-// kernels (the ray marcher, the dissertation's Lobe Estimator), one line each. Columns: the
-// enumerator, the name (the scene key's value, the names in outputs, and a real-time algorithm's
-// kernel: kernels/NAME.cl's `NAME`), whether it renders frames (one launch a frame, no samples to
-// accumulate: render/realtime_renderer.h) rather than samples.
+// What renders the scene (renderer.algorithm): the path tracer, the ray marcher or the Lobe Estimator.
+// Columns: enumerator; name (scene key value, name in outputs, real-time kernel kernels/NAME.cl `NAME`);
+// whether it renders frames (one launch each, no samples to accumulate: render/realtime_renderer.h).
 #define ALGORITHMS(X)                  \
   X(Pathtrace, "pathtrace", false)      \
   X(Raymarch, "raymarch", true)         \
@@ -196,9 +182,8 @@ enum class LobeVariant { Eq7, Corrected };
 #define ALGORITHM_ENUMERATOR(cxx, name, realtime) cxx,
 enum class Algorithm { ALGORITHMS(ALGORITHM_ENUMERATOR) };
 #undef ALGORITHM_ENUMERATOR
-// "pathtrace", "raymarch", "lobe": the scene key's values and the names in outputs.
+// The ALGORITHMS table's name (scene key value, name in outputs) and frames column.
 const char* algorithmName(Algorithm a);
-// Raymarch and Lobe: one launch a frame, no samples to accumulate.
 bool isRealtime(Algorithm a);
 // The algorithm called `name` (algorithmName's inverse); false, *out untouched, for any other name.
 bool algorithmFromName(const std::string& name, Algorithm* out);
@@ -209,8 +194,7 @@ struct LobeSettings {
   int lobePoints = 30;
   float lobeRadius = 1.0f;       // eq7: world units; corrected: mean free paths of unit density
   int shadowSteps = 100;
-  int firstHitSteps = 60;        // samples of the first-hit search (then 6 bisections); both
-                                 // variants: of the emission march (lobe.h)
+  int firstHitSteps = 60;        // first-hit search samples (then 6 bisections); also the emission march's
   int viewSteps = 0;             // samples of each transmittance from the first hit to a lobe point
                                  // (corrected: of its one view march); 0 = the variant's: eq7 24, corrected 16
   float minTransmittance = 1e-3f;  // those transmittances stop below it (lobe.h: error < it · L_b)
@@ -256,9 +240,9 @@ struct Scene {
 // Loads and validates a scene. `overrides` are "dotted.path=value" strings (--set) applied to the
 // JSON before validation. Throws InputError ("FILE: KEY: what is wrong") on any bad input.
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
-// The same from JSON text already in memory; `path` names it in messages and anchors relative paths.
-// `keysAsked`, when given, receives every key the loader looked up (present or not), as the
-// scene-format reference names it ("materials[].g"): the schema, for the documentation check.
+// The same from JSON text in memory; `path` names it in messages and anchors relative paths. `keysAsked`, if
+// given, gets every key the loader looked up (present or not) as the scene-format reference names it
+// ("materials[].g"): the schema, for the documentation check.
 Scene parseScene(const std::string& jsonText, const std::string& path,
                  const std::vector<std::string>& overrides = {}, std::set<std::string>* keysAsked = nullptr);
 

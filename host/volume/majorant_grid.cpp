@@ -1,32 +1,26 @@
 // majorant_grid.cpp: building the majorant grid (majorant_grid.h).
 //
-// The bound. Along one axis, grid_density (kernels/shared/grid.h) takes f = p - 0.5, x0 = floor(f),
-// a = f - x0 in [0, 1), and weights voxel x0 by 1 - a and voxel x0 + 1 by a. Voxel j therefore
-// carries a positive weight at p only if j = x0 (j + 0.5 <= p < j + 1.5) or j = x0 + 1 with a > 0
-// (j - 0.5 < p < j + 0.5): only on its open support j - 0.5 < p < j + 1.5, centre j + 0.5 ± 1.
-// In 3D the value is sum_corners w·v over the 8 corners, w the product of the axis weights: w >= 0,
-// sum w = 1, and corners outside the grid read v = 0. So the value is at most the largest v over
-// the corners with w > 0, or 0 (the max starts at 0 and stands for every out-of-grid voxel).
-// For p in [A, B] on an axis, a corner j with positive weight has j > p - 1.5 >= A - 1.5 and
-// j < p + 0.5 <= B + 0.5; for an integer j, j > A - 1.5 <=> j >= floor(A - 0.5), and
-// j < B + 0.5 <=> j <= ceil(B - 0.5). The axes are independent, so every corner with positive
-// weight anywhere in the closed cell [A, B] (per axis) lies in the product of the three ranges
-// floor(A - 0.5) .. ceil(B - 0.5), and the cell value (their max, and 0) bounds the density there.
+// The bound. Along one axis grid_density (kernels/shared/grid.h) takes f = p - 0.5, x0 = floor(f),
+// a = f - x0 in [0, 1), weighting voxel x0 by 1 - a and x0 + 1 by a: voxel j has positive weight only on its
+// open support j - 0.5 < p < j + 1.5 (as x0: j + 0.5 <= p < j + 1.5; as x0 + 1, a > 0: j - 0.5 < p < j + 0.5).
+// In 3D the value is sum w·v over the 8 corners, w the product of axis weights (w >= 0, sum w = 1; corners
+// outside the grid read v = 0), so at most the largest v over corners with w > 0, or 0 (the max starts at 0,
+// standing for every out-of-grid voxel). For p in [A, B] on an axis, such a j has A - 1.5 <= p - 1.5 < j <
+// p + 0.5 <= B + 0.5, i.e. floor(A - 0.5) <= j <= ceil(B - 0.5) for integer j. The axes are independent, so
+// every corner with positive weight anywhere in the closed cell [A, B] (per axis) lies in the product of the
+// three ranges, and the cell value (their max, and 0) bounds the density there.
 //
-// It is also the least bound made from voxel values alone: each j in the range has a piece of the
-// cell of positive length where its weight is positive ((j - 0.5, j + 1.5) meets [A, B] since
-// j > A - 1.5 and j < B + 0.5), and at a voxel centre inside the cell the density equals that voxel
-// (weight 1), so when the largest relevant voxel has its centre in the cell the bound is attained.
+// It is the least bound from voxel values alone: each j in the range has positive weight on a positive-length
+// part of the cell ((j - 0.5, j + 1.5) meets [A, B] as j > A - 1.5, j < B + 0.5), and at a voxel centre the
+// density is that voxel's value (weight 1): attained when the largest relevant voxel's centre is in the cell.
 //
-// Float rounding. The DDA (kernels/shared/majorant_dda.h) assigns points to cells with float
-// arithmetic, a few ulps of the index coordinates either side of a face, so every cell is grown by
-// MAJORANT_SLACK = 1/256 index units before taking its range: that only enlarges the range, and
-// the bound holds up to 1/256 outside the cell. It costs nothing except where a cell face lies on
-// a plane of voxel centres (A or B = m + 0.5): the range then also takes the voxel whose support
-// only touches the face. (Faces sit at k·n/c, so A - 0.5 is a multiple of 1/(2c) away from an
-// integer: for c < 128 cells an axis, 1/256 reaches no other voxel.) The lerps themselves round
-// too: the host's can exceed the largest corner by a few ulps (a GPU sampler's fixed-point weights
-// stay convex); MAJORANT_MARGIN on σ̄ covers that, as the global majorant's margin does.
+// Float rounding. The DDA (kernels/shared/majorant_dda.h) assigns points to cells in float, a few ulps of the
+// index coordinates either side of a face, so each cell is grown by MAJORANT_SLACK = 1/256 index units before
+// taking its range: that only enlarges it, and the bound holds up to 1/256 outside the cell. Only a face on a
+// plane of voxel centres (A or B = m + 0.5) then takes one more voxel, whose support merely touches it (faces
+// sit at k·n/c, so A - 0.5 is a multiple of 1/(2c) from an integer: for c < 128 cells an axis, 1/256 reaches
+// no other voxel). The lerps round too: the host's can exceed the largest corner by a few ulps (a GPU
+// sampler's fixed-point weights stay convex); MAJORANT_MARGIN on σ̄ covers that, as for the global majorant.
 #include "volume/majorant_grid.h"
 
 #include <algorithm>
@@ -96,8 +90,7 @@ MajorantGrid buildMajorantGrid(const DenseGrid& density, int cellsX, int cellsY,
   const AxisRanges ry = axisRanges(ny, cellsY, g.cellSize[1]);
   const AxisRanges rz = axisRanges(nz, cellsZ, g.cellSize[2]);
 
-  // The max over a box of voxels is separable: along x, then y, then z (each voxel is read about
-  // 1 + 2/cellSize times instead of (1 + 2/cellSize)³).
+  // Separable max over x, then y, then z: each voxel is read about 1 + 2/cellSize times, not (1 + 2/cellSize)³.
   const size_t cx = size_t(cellsX), cy = size_t(cellsY), cz = size_t(cellsZ);
   std::vector<float> byX(cx * size_t(ny) * size_t(nz), 0.0f);  // (cell x, voxel y, voxel z)
   for (size_t yz = 0; yz < size_t(ny) * size_t(nz); ++yz) {

@@ -1,18 +1,15 @@
 // make_cloud.cpp: a procedural cumulus-like cloud, deterministic for (resolution, seed).
-//
 // Recipe (model space, y up, the cloud base at y = 0):
-//   1. 8-20 spheres ("blobs") placed from a counter-based hash of (seed, index): a large central
-//      blob, base blobs on a flattened disc (larger near the centre), and child blobs stacked on
-//      earlier ones (the cauliflower towers of a cumulus).
+//   1. 8-20 spheres ("blobs") from a counter-based hash of (seed, index): a large central blob, base blobs
+//      on a flattened disc (larger, taller near the centre), children on earlier blobs' upper hemispheres (towers).
 //   2. Signed distance d = smooth union of the spheres (polynomial smooth-min, width kSmooth).
 //   3. Displacement d' = d - kAmp * n, n in [-1, 1] billowy fractal gradient noise (kOctaves octaves).
 //   4. Density = smoothstep(0, kEdge, -d') (soft edges) * smoothstep(0, kBaseFade, y) (flat base).
-//   5. The model's bounding box (blob extents + the largest displacement) is fitted uniformly into
-//      [kFit, 1 - kFit]^3 of the unit cube, centred; voxel centres (i + 0.5) / resolution are
-//      evaluated there, so the shape does not depend on the resolution. Voxels whose centre lies
-//      within kCloudMargin of a face are exactly 0 (the fit keeps the cloud clear of them anyway).
-// Only integer hashing and float arithmetic in a fixed order: the same bits on every run, for any
-// thread count and any split into slabs of z slices (each voxel is computed independently).
+//   5. The model's bounding box (blob extents + largest displacement) is fitted uniformly, centred, into
+//      [kFit, 1 - kFit]^3 and sampled at voxel centres (i + 0.5) / resolution (shape independent of the
+//      resolution); voxels centred within kCloudMargin of a face are exactly 0 (the fit stays clear of them).
+// Only integer hashing and float arithmetic in a fixed order: the same bits on every run, for any thread
+// count and any split into z slabs (each voxel is computed independently).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -117,7 +114,7 @@ float billow(float x, float y, float z, uint32_t seed) {
   float sum = 0.0f, amp = 1.0f, norm = 0.0f, f = kFreq;
   for (int o = 0; o < kOctaves; ++o) {
     const uint32_t s = hash32(seed + 0x632be5abu * uint32_t(o + 1));
-    // Per-octave offsets keep lattice points of different octaves apart.
+    // Per-octave offsets keep the octaves' lattice points apart.
     const float off = 0.37f * float(o);
     sum += amp * (2.5f * std::fabs(gradientNoise(x * f + off, y * f - off, z * f + 2.0f * off, s)) - 0.6f);
     norm += amp;
@@ -142,7 +139,6 @@ std::vector<Blob> placeBlobs(uint32_t seed) {
   for (int k = 1; k < n; ++k) {
     const float choice = rnd.uniform();
     if (k >= 2 && choice < 0.5f) {
-      // A child on the upper hemisphere of an earlier blob.
       const Blob& p = blobs[size_t(rnd.bits() % uint32_t(k))];
       const float theta = kTwoPi * rnd.uniform();
       const float cosPhi = 0.45f + 0.5f * rnd.uniform();
@@ -151,7 +147,6 @@ std::vector<Blob> placeBlobs(uint32_t seed) {
       const float reach = 0.85f * p.r;
       blobs.push_back({p.x + reach * sinPhi * std::cos(theta), p.y + reach * cosPhi, p.z + reach * sinPhi * std::sin(theta), r});
     } else {
-      // A base blob on a flattened disc: larger and taller near the centre.
       const float theta = kTwoPi * rnd.uniform();
       const float t = std::sqrt(rnd.uniform());  // 0 centre .. 1 rim
       const float rad = 0.32f * t;

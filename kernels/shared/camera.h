@@ -1,14 +1,13 @@
-/* camera.h: primary rays. Pixel (0,0) is the top-left corner; (jx, jy) in [0,1)² jitters the sample
- * inside the pixel. A thin lens of radius lens_radius focuses at distance focus_distance along the
- * view axis (pbrt-v4 §5.2.3); lens_radius 0 is a pinhole. */
+/* camera.h: primary rays. Pixel (0,0) is the top-left corner; (jx, jy) in [0,1)² jitters the sample inside
+ * it. A thin lens of radius lens_radius focuses at focus_distance along the view axis (pbrt-v4 §5.2.3). */
 #ifndef NARVAL_CAMERA_H
 #define NARVAL_CAMERA_H
 
 #include "shared/sampling.h"
 #include "shared/structs.h"
 
-/* -DCAMERA_PINHOLE (scene specialisation, host/render/kernel_features.h): the host sets it when
- * lens_radius is not positive, which the runtime test would also take as a pinhole; bit for bit. */
+/* -DCAMERA_PINHOLE (scene specialisation, host/render/kernel_features.h): lens_radius not positive,
+ * which the runtime test also takes as a pinhole; bit for bit. */
 #ifdef CAMERA_PINHOLE
 #define CAMERA_HAS_LENS(c) 0
 #else

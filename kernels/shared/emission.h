@@ -1,23 +1,16 @@
-/* emission.h: emissive media, pbrt-v4's model (DESIGN.md "Emission"): the medium emits σa(x)·Le(x)
- * per unit length, so the radiance equation along a ray gains ∫ T(t) σa(t) Le(t) dt. Le is, by
- * kind (emission_kinds.h),
- *   EMISSION_COLOR      colour · scale · v(x)           (v: the emission grid, e.g. EmberGen's
- *                                                        `flames`; 1 without a grid)
- *   EMISSION_BLACKBODY  scale · B((v(x) − offset) · s)  (v: a temperature grid; pbrt-v4's
- *                                                        temperatureoffset / temperaturescale)
- * B is the blackbody colour of host/colour/blackbody.h (peak-normalised Planck spectrum through the
- * CIE 1931 matching functions into linear sRGB, 0 at or below 100 K), tabulated by the host over
- * [0, table_max] kelvin, table_max at least the hottest temperature the grid can give, and read
- * with linear interpolation: the table is interpolated, not the colour per voxel, so B follows the
- * temperature trilinearly reconstructed at x, as pbrt-v4 evaluates it.
- * The emission grid has its own index space (its own transform and bounding box in the file);
- * emission_params.index_to_grid maps the medium's index space into it.
+/* emission.h: emissive media, pbrt-v4's model (DESIGN.md "Emission"): the medium emits σa(x)·Le(x) per
+ * unit length, so the radiance along a ray gains ∫ T(t) σa(t) Le(t) dt. Le by kind (emission_kinds.h):
+ *   EMISSION_COLOR      colour · scale · v(x)           (v: the emission grid, e.g. EmberGen's `flames`; else 1)
+ *   EMISSION_BLACKBODY  scale · B((v(x) − offset) · s)  (v: a temperature grid; pbrt-v4's temperatureoffset/-scale)
+ * B: host/colour/blackbody.h's colour (peak-normalised Planck spectrum through the CIE 1931 matching functions
+ * into linear sRGB, 0 at or below 100 K), tabulated by the host over [0, table_max] kelvin (table_max at least
+ * the grid's hottest) and interpolated linearly: the table, not the colour per voxel, so B follows the
+ * temperature trilinearly reconstructed at x, as in pbrt-v4. The emission grid has its own index space
+ * (transform, bounding box), reached from the medium's by emission_params.index_to_grid.
  *
- * Built only with -DEMISSION (host/render/kernel_features.h): without it nothing here is compiled
- * and no kernel function reads the emission grid or table (kernel_context.h holds them). Host code
- * includes it where it defines EMISSION itself (tests). Who collects it: tracking_delta at every
- * tentative collision (the path tracer, tracking.h), the ray marcher's view march (raymarch.h) and
- * march_emission (the Lobe Estimator, lobe.h). */
+ * Built only with -DEMISSION (host/render/kernel_features.h; host tests define it): otherwise nothing here
+ * compiles and no kernel reads the emission grid or table (kernel_context.h). Collected by tracking_delta at
+ * each tentative collision (path tracer, tracking.h), the view march (raymarch.h) and march_emission (lobe.h). */
 #ifndef NARVAL_EMISSION_H
 #define NARVAL_EMISSION_H
 
@@ -43,9 +36,8 @@ static inline float emission_grid_value(KERNEL_CONTEXT_PARAM, vec3 p) {
 /* Nothing is emitted at or below this temperature (pbrt-v4's rule), whatever the table holds. */
 #define EMISSION_MIN_KELVIN 100.0f
 
-/* B(T) from the table: linear interpolation between the entries around T, the last entry above
- * table_max (the host sizes the table so that no temperature of the grid gets there), exactly 0
- * for T at or below EMISSION_MIN_KELVIN and for NaN. */
+/* B(T) from the table, linearly interpolated; the last entry above table_max (sized so that no grid
+ * temperature gets there); exactly 0 for T at or below EMISSION_MIN_KELVIN and for NaN. */
 static inline vec3 emission_blackbody(NV_CONSTANT const emission_params* e, NV_GLOBAL const float* table, float T) {
   if (!(T > EMISSION_MIN_KELVIN)) return vec3_splat(0.0f);
   const int last = e->table_size - 1;
@@ -56,8 +48,7 @@ static inline vec3 emission_blackbody(NV_CONSTANT const emission_params* e, NV_G
   return vec3_make(lo[0] + a * (lo[3] - lo[0]), lo[1] + a * (lo[4] - lo[1]), lo[2] + a * (lo[5] - lo[2]));
 }
 
-/* Le at medium index point p. An unknown kind emits nothing (reported at the kernel's entry,
- * scene_kinds.h). */
+/* Le at medium index point p; an unknown kind emits nothing (reported at the kernel's entry, scene_kinds.h). */
 static inline vec3 emission_radiance(KERNEL_CONTEXT_PARAM, vec3 p) {
   NV_CONSTANT const emission_params* e = &ctx->medium->emission;
   switch (e->kind) {

@@ -1,9 +1,8 @@
-/* light.h: the lights, dispatched over the registry (light_kinds.h) to each kind's header.
- * An unknown kind sends no light; every kernel's entry reports it (scene_kinds.h,
- * STATUS_UNKNOWN_KIND) and the host never uploads one (render/kernel_features.h checks).
- * Scene specialisation (host/render/kernel_features.h): -DLIGHT_FIXED=<id> when every light of the
- * scene is of that kind, so the switches fold (a kind no ray can hit leaves light_hit_nearest
- * nothing to do). Same arithmetic as the generic kernel. */
+/* light.h: the lights, dispatched over the registry (light_kinds.h) to each kind's header. An unknown
+ * kind sends no light; every kernel's entry reports it (scene_kinds.h, STATUS_UNKNOWN_KIND) and the host
+ * never uploads one (render/kernel_features.h). Scene specialisation (host/render/kernel_features.h):
+ * -DLIGHT_FIXED=<id> when every light is of that kind, so the switches fold (a kind no ray can hit leaves
+ * light_hit_nearest nothing to do); same arithmetic as the generic kernel. */
 #ifndef NARVAL_LIGHT_H
 #define NARVAL_LIGHT_H
 
@@ -27,8 +26,7 @@
 #define LIGHT_CASE_ESCAPED(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_escaped(l, d);
 #define LIGHT_CASE_POWER(id, val, nm, k, sc, ar, vk, key, lo, hi, fb) case id: return light_##k##_power(l);
 
-/* A light of `kind` with `radiance` (its emitter's albedo) placed by pl (light_sample.h); an
- * unknown kind keeps its id, so the checks downstream see it. */
+/* A `kind` light of `radiance` (its emitter's albedo) placed by pl (light_sample.h); unknown kinds keep their id. */
 static inline light_params light_make(int kind, vec3 radiance, light_placement pl) {
   light_params l;
   l.corner = l.edge_u = l.edge_v = l.normal = vec3_to4(vec3_splat(0.0f), 0.0f);
@@ -42,8 +40,7 @@ static inline light_params light_make(int kind, vec3 radiance, light_placement p
   }
 }
 
-/* Samples light l as seen from x for next-event estimation; 0 when it cannot contribute (back
- * side, degenerate, an unknown kind). */
+/* Samples light l from x for next-event estimation; 0 when it cannot contribute (back side, degenerate, unknown). */
 static inline int light_sample_point(NV_CONSTANT const light_params* l, vec3 x, float u1, float u2,
                                      NV_PRIVATE light_sample* s) {
   switch (LIGHT_KIND(l)) {
@@ -52,8 +49,7 @@ static inline int light_sample_point(NV_CONSTANT const light_params* l, vec3 x, 
   }
 }
 
-/* Where the ray o + t·d (t > t_min) meets light l's surface, NV_INFINITY where it does not (a
- * delta light never); *front: 1 on the emitting side. */
+/* Where o + t·d (t > t_min) meets l's surface, else NV_INFINITY (delta: always); *front: 1 on the emitting side. */
 static inline float light_hit(NV_CONSTANT const light_params* l, vec3 o, vec3 d, float t_min, NV_PRIVATE int* front) {
   switch (LIGHT_KIND(l)) {
     LIGHT_KINDS(LIGHT_CASE_HIT)
@@ -78,8 +74,8 @@ static inline vec3 light_escaped(NV_CONSTANT const light_params* l, vec3 d) {
   }
 }
 
-/* Unit direction from x towards the light's centre (0 when x is there) and *dist, the distance
- * to it: the cache's guide's axis, and the real-time shadow ray of a light taken as one point. */
+/* Unit direction from x to the light's centre (0 when x is there) and *dist, the distance: the cache's
+ * guide's axis, and the real-time shadow ray of a light taken as one point. */
 static inline vec3 light_axis(NV_CONSTANT const light_params* l, vec3 x, NV_PRIVATE float* dist) {
   switch (LIGHT_KIND(l)) {
     LIGHT_KINDS(LIGHT_CASE_AXIS)

@@ -1,7 +1,6 @@
-/* light_rectangle.h: a one-sided rectangle light: corner + s·edge_u + t·edge_v, s, t in [0, 1],
- * emitting radiance `radiance` along `normal` (normal.w holds the area). Next-event estimation
- * samples its area uniformly; a ray that meets its front sees Le (MIS-weighted by light_pdf).
- * The real-time kernels' K×K points and exact phase integral over it: light_rectangle_area.h. */
+/* light_rectangle.h: a one-sided rectangle light corner + s·edge_u + t·edge_v, s, t in [0, 1], emitting
+ * `radiance` along `normal` (normal.w: the area). Next-event estimation samples its area uniformly; a ray
+ * meeting its front sees Le (MIS-weighted by light_pdf). Real-time K×K points, exact phase: light_rectangle_area.h. */
 #ifndef NARVAL_LIGHT_RECTANGLE_H
 #define NARVAL_LIGHT_RECTANGLE_H
 
@@ -30,8 +29,7 @@ static inline int light_rectangle_sample(NV_CONSTANT const light_params* l, vec3
   return 1;
 }
 
-/* Ray o + t·d against the parallelogram: the distance (> t_min) or NV_INFINITY; *front is 1 when
- * the ray arrives on the emitting side. */
+/* Ray o + t·d against the parallelogram: the distance (> t_min) or NV_INFINITY; *front: 1 on the emitting side. */
 static inline float light_rectangle_hit(NV_CONSTANT const light_params* l, vec3 o, vec3 d, float t_min,
                                         NV_PRIVATE int* front) {
   const vec3 n = vec3_from4(l->normal);

@@ -13,10 +13,9 @@ typedef struct light_sample {
   float pdf;      /* solid-angle pdf; 0 for a delta light (no MIS) */
 } light_sample;
 
-/* The light as one point seen from x (the real-time kernels' light, dissertation §4.2): unit
- * direction, the shadow ray's length, and the intensity I towards x that falls off as I/r²: r² is
- * range·range in the ray marcher's and the lobe's own sums and range2 (the squared distance as
- * computed) in the area sums, so each keeps its arithmetic. */
+/* The light as one point seen from x (the real-time kernels' light, dissertation §4.2): unit direction,
+ * shadow ray length, and intensity I towards x, falling off as I/r²: r² = range·range in the ray marcher's
+ * and lobe's own sums, range2 (the squared distance as computed) in the area sums, so each keeps its arithmetic. */
 typedef struct light_point_view {
   vec3 dir;
   float dist;
@@ -25,11 +24,10 @@ typedef struct light_point_view {
   float range2;
 } light_point_view;
 
-/* Where a light is placed on the host: the primitive's transform applied to the unit quad
- * [-0.5, 0.5]² in local XY (corner, edges), its unit -Z through the rotation alone (normal, the
- * emitting side) and its position; the kind's own keys (light_kinds.h: vector, parameter); and the
- * radius of a sphere around the medium (for the power of a light from infinitely far). Each kind
- * takes what it needs (light_<kind>_make). */
+/* Where the host places a light: the primitive's transform on the unit quad [-0.5, 0.5]² in local XY (corner,
+ * edges), its unit -Z through the rotation alone (normal, the emitting side) and position; the kind's own keys
+ * (light_kinds.h: vector, parameter); the radius of a sphere around the medium (power of a light at infinity).
+ * Each kind takes what it needs (light_<kind>_make). */
 typedef struct light_placement {
   vec3 position, corner, edge_u, edge_v, normal, vector;
   float area, parameter, scene_radius;

@@ -1,12 +1,9 @@
-/* phase.h: phase functions, dispatched over the registry (phase_kinds.h) to each kind's header.
- * θ is the angle between the propagation directions before (w_in) and after (w_out) scattering, so
- * g > 0 scatters forward (DESIGN.md, physics conventions). Every kind samples μ = cos θ exactly, so
- * the pdf of a sampled direction is its value (the weight eval/pdf is 1).
- * An unknown kind gives no scattering here; every kernel's entry reports it (scene_kinds.h,
- * STATUS_UNKNOWN_KIND) and the host never uploads one (render/kernel_features.h checks).
- * Scene specialisation (DESIGN.md "model only what a scene needs"; host/render/kernel_features.h):
- * -DPHASE_FIXED=<id> fixes the kind at build time, so the compiler folds the switches (the host
- * sets it only to the scene's kind: the arithmetic is the generic kernel's, bit for bit). */
+/* phase.h: phase functions, dispatched over the registry (phase_kinds.h) to each kind's header. θ is the
+ * angle between the propagation directions before (w_in) and after (w_out) scattering: g > 0 scatters forward
+ * (DESIGN.md, physics conventions). Each kind samples μ = cos θ exactly (pdf = value, eval/pdf = 1). An unknown
+ * kind scatters nothing; each kernel's entry reports it (scene_kinds.h, STATUS_UNKNOWN_KIND) and the host never
+ * uploads one (render/kernel_features.h). -DPHASE_FIXED=<id> (scene specialisation, DESIGN.md) fixes the kind
+ * so the switches fold; the host sets it only to the scene's kind (bit for bit as generic). */
 #ifndef NARVAL_PHASE_H
 #define NARVAL_PHASE_H
 
@@ -39,8 +36,7 @@ static inline float phase_clamp(int kind, float x) {
   }
 }
 
-/* The phase function of `kind` with its one parameter x (phase_kinds.h); an unknown kind keeps its
- * id, so the checks downstream see it. */
+/* The `kind` phase function with parameter x (phase_kinds.h); an unknown kind keeps its id for the checks. */
 static inline phase_params phase_make(int kind, float x) {
   switch (kind) {
     PHASE_KINDS(PHASE_CASE_MAKE)
@@ -107,10 +103,9 @@ static inline phase_params phase_scaled(phase_params p, float c) {
 
 static inline float phase_eval(phase_params p, vec3 w_in, vec3 w_out) { return phase_eval_mu(p, vec3_dot(w_in, w_out)); }
 
-/* Samples w_out given the propagation direction w_in; returns it and writes its pdf (0 for an
- * unknown kind: the path goes on unscattered and no MIS weight uses it). The pdf is the value at
- * the direction actually returned: for a peak a few float steps of μ wide (HG at |g| near 1), MIS
- * needs the same value phase_pdf gives for this direction. */
+/* Samples w_out given the propagation direction w_in; returns it and writes its pdf (0 for an unknown
+ * kind: the path goes on unscattered and no MIS weight uses it). The pdf is evaluated at the returned
+ * direction: for a peak a few float steps of μ wide (HG at |g| near 1), MIS needs phase_pdf's value. */
 static inline vec3 phase_sample(phase_params p, vec3 w_in, float u1, float u2, NV_PRIVATE float* pdf) {
   if (!phase_known(PHASE_KIND(p.kind))) {
     *pdf = 0.0f;

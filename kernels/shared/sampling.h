@@ -45,8 +45,7 @@ static inline vec3 sample_direction_around(vec3 w, float cos_theta, float u) {
                   vec3_scale(w, cos_theta));
 }
 
-/* Power heuristic with β = 2 (Veach 1997) for one sample from each of two strategies. A sample
- * neither strategy could draw (both pdfs 0) gets weight 0, not 0/0. */
+/* Power heuristic, β = 2 (Veach 1997), one sample per strategy; both pdfs 0 gives weight 0, not 0/0. */
 static inline float mis_power_heuristic(float pdf_a, float pdf_b) {
   const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
   return a + b > 0.0f ? a / (a + b) : 0.0f;
