@@ -1,5 +1,7 @@
 #include "render/realtime_params.h"
 
+#include <stdexcept>
+
 #include "render/device_light_cache.h"
 #include "render/node_grid_layout.h"
 

@@ -52,16 +52,29 @@ static inline float grid_trilinear_combine(float v000, float v100, float v010, f
   return c0 * wz0 + c1 * wz1;
 }
 
-/* Trilinear value of the dense grid `data` (nx·ny·nz floats, x fastest, all finite, nx·ny < 2^31)
- * at index-space point p (notes above). Inside [0.5, n - 0.5] on every axis it reproduces a field
- * linear in x, y and z (to rounding); NaN coordinates read 0. */
-static inline float grid_trilinear(NV_GLOBAL const float* data, int nx, int ny, int nz, vec3 p) {
+/* The trilinear filter's cell of index-space point p, clamped as above: its lower corner voxel
+ * (x0, y0, z0) and the upper corners' weights (ax, ay, az). */
+typedef struct grid_cell {
+  int x0, y0, z0;
+  float ax, ay, az;
+} grid_cell;
+
+static inline grid_cell grid_locate(vec3 p) {
   const float fx = nv_fmin(nv_fmax(p.x, -1.0f), 1.0e7f) - 0.5f;
   const float fy = nv_fmin(nv_fmax(p.y, -1.0f), 1.0e7f) - 0.5f;
   const float fz = nv_fmin(nv_fmax(p.z, -1.0f), 1.0e7f) - 0.5f;
   const float x0f = nv_floor(fx), y0f = nv_floor(fy), z0f = nv_floor(fz);
-  const int x0 = (int)x0f, y0 = (int)y0f, z0 = (int)z0f;
-  const float ax = fx - x0f, ay = fy - y0f, az = fz - z0f;
+  const grid_cell c = {(int)x0f, (int)y0f, (int)z0f, fx - x0f, fy - y0f, fz - z0f};
+  return c;
+}
+
+/* Trilinear value of the dense grid `data` (nx·ny·nz floats, x fastest, all finite, nx·ny < 2^31)
+ * at index-space point p (notes above). Inside [0.5, n - 0.5] on every axis it reproduces a field
+ * linear in x, y and z (to rounding); NaN coordinates read 0. */
+static inline float grid_trilinear(NV_GLOBAL const float* data, int nx, int ny, int nz, vec3 p) {
+  const grid_cell cell = grid_locate(p);
+  const int x0 = cell.x0, y0 = cell.y0, z0 = cell.z0;
+  const float ax = cell.ax, ay = cell.ay, az = cell.az;
   if (x0 >= 0 && y0 >= 0 && z0 >= 0 && x0 < nx - 1 && y0 < ny - 1 && z0 < nz - 1) {
     /* All eight corners inside (almost every lookup): one base address, fixed strides, the same
      * products and sums as below, so the same bits, and faster (bench/RESULTS.md). nx·ny fits an
@@ -109,12 +122,9 @@ static inline int grid_brick_count(int n) { return (n + GRID_BRICK - 1) >> GRID_
  * all finite and >= 0), at index-space point p: the same value, bit for bit. */
 static inline float grid_bricks_trilinear(NV_GLOBAL const uint* table, NV_GLOBAL const float* pool, int nx, int ny,
                                           int nz, vec3 p) {
-  const float fx = nv_fmin(nv_fmax(p.x, -1.0f), 1.0e7f) - 0.5f;
-  const float fy = nv_fmin(nv_fmax(p.y, -1.0f), 1.0e7f) - 0.5f;
-  const float fz = nv_fmin(nv_fmax(p.z, -1.0f), 1.0e7f) - 0.5f;
-  const float x0f = nv_floor(fx), y0f = nv_floor(fy), z0f = nv_floor(fz);
-  const int x0 = (int)x0f, y0 = (int)y0f, z0 = (int)z0f;
-  const float ax = fx - x0f, ay = fy - y0f, az = fz - z0f;
+  const grid_cell cell = grid_locate(p);
+  const int x0 = cell.x0, y0 = cell.y0, z0 = cell.z0;
+  const float ax = cell.ax, ay = cell.ay, az = cell.az;
   const int xa = grid_clamp_index(x0, nx), ya = grid_clamp_index(y0, ny), za = grid_clamp_index(z0, nz);
   const int bx = xa >> GRID_BRICK_LOG2, by = ya >> GRID_BRICK_LOG2, bz = za >> GRID_BRICK_LOG2;
   const uint slot = table[(size_t)bx + (size_t)grid_brick_count(nx) *
