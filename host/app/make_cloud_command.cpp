@@ -21,6 +21,7 @@ Command addMakeCloudCommand(CLI::App& app) {
   sub->add_option("--resolution", a->resolution, "Voxels per side")->check(between(8, 2048));
   sub->add_option("--seed", a->seed, "Shape seed");
   return {sub, [a]() {
+            checkOutputWritable(a->out, "OUT.vdb");  // its folder made, before any work
             const auto t0 = std::chrono::steady_clock::now();
             // Slab by slab (about 256 MiB each, whole leaf nodes): the dense cloud is never held
             // (a 1024^3 one would be 4 GiB, 2048^3 32 GiB). Same file as writeVdb(makeCloud(...)).

@@ -156,6 +156,19 @@ TEST_F(Cli, MakeCloudWritesTheGeneratedGrid) {
   EXPECT_NEAR(a, b, 1e-9 * b);
 }
 
+// The output's folder is made as the other commands make theirs; a folder in the way is one line,
+// exit 2, before any work.
+TEST_F(Cli, MakeCloudMakesItsFolderAndRefusesAFolderAsOutput) {
+  const RunResult r = run("make-cloud new/deeper/c.vdb --resolution 8");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "new" / "deeper" / "c.vdb"));
+  fs::create_directories(dir_ / "taken.vdb");
+  const RunResult refused = run("make-cloud taken.vdb --resolution 8");
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_EQ(refused.err, "narval: OUT.vdb: cannot write taken.vdb: it is a folder\n");
+  EXPECT_EQ(refused.out, "");
+}
+
 }  // namespace
 }  // namespace narval
 
