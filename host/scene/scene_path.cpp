@@ -35,6 +35,19 @@ size_t findClose(const std::string& text, size_t from) {
   return std::string::npos;
 }
 
+// For a path that was not found: what its first ${NAME} reference says to check, "" without one.
+std::string variableHint(const std::string& raw) {
+  const size_t at = raw.find("${");
+  if (at == std::string::npos) return "";
+  size_t n = at + 2;
+  while (n < raw.size() && isNameChar(raw[n], n == at + 2)) ++n;
+  const std::string name = raw.substr(at + 2, n - at - 2);
+  if (name.empty()) return "";
+  const char* value = std::getenv(name.c_str());
+  if (value && *value) return " (from " + name + "=" + value + ")";
+  return " (" + name + " is not set: set it to the folder that holds the file)";
+}
+
 }  // namespace
 
 std::string expandEnvironment(const std::string& text, const std::string& file, const std::string& key) {
@@ -90,7 +103,7 @@ std::string resolveVolumePath(const std::string& raw, const std::string& sceneFi
                      "unsupported volume file type \"" + p.extension().string() + "\" (allowed: .vdb, .vol): " + resolved);
   std::error_code ec;
   const fs::file_status status = fs::status(resolved, ec);
-  if (!fs::exists(status)) throw inputError(sceneFile, key, "volume file not found: " + resolved);
+  if (!fs::exists(status)) throw inputError(sceneFile, key, "volume file not found: " + resolved + variableHint(raw));
   if (!fs::is_regular_file(status)) throw inputError(sceneFile, key, "volume path is not a file: " + resolved);
   return resolved;
 }

@@ -653,6 +653,17 @@ TEST_F(SceneFiles, DataDirFromTheEnvironment) {
                   "(write ${NARVAL_DATA_DIR:-default} to give a fallback)");
   }
   {
+    // A grid that is not there says which variable placed the path, and whether it is set.
+    ScopedEnv env("NARVAL_DATA_DIR", std::nullopt);
+    EXPECT_EQ(errorOfText(withPath(minimalScene(), "${NARVAL_DATA_DIR:-fallback}/none.vdb"), {}, scenePath()),
+              scenePath() + ": materials[1].path: volume file not found: " + (dir_ / "fallback/none.vdb").string() +
+                  " (NARVAL_DATA_DIR is not set: set it to the folder that holds the file)");
+    ScopedEnv set("NARVAL_DATA_DIR", (dir_ / "data").string());
+    EXPECT_EQ(errorOfText(withPath(minimalScene(), "${NARVAL_DATA_DIR:-fallback}/none.vdb"), {}, scenePath()),
+              scenePath() + ": materials[1].path: volume file not found: " + (dir_ / "data/none.vdb").string() +
+                  " (from NARVAL_DATA_DIR=" + (dir_ / "data").string() + ")");
+  }
+  {
     ScopedEnv env("NARVAL_DATA_DIR", "");  // set but empty: the default applies, as in a shell
     ScopedEnv other("NARVAL_TEST_FALLBACK", (dir_ / "fallback").string());
     EXPECT_EQ(parseScene(withPath(minimalScene(), "${NARVAL_DATA_DIR:-${NARVAL_TEST_FALLBACK}}/a.vdb"),
