@@ -335,6 +335,49 @@ void warnIfDark(const JsonContext& ctx, const Scene& scene) {
   ctx.warn("", "no light, no emission and a black background: the image will be black");
 }
 
+// A key written twice in one object: JSON parsers keep one of the two silently (nlohmann the last),
+// so the other setting would be lost. Followed through the parser's events, with the key path of
+// what is being parsed, for the message.
+class DuplicateKeys {
+ public:
+  void see(const JsonContext& ctx, json::parse_event_t event, const json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start: frames_.push_back(Frame{true, {}, "", 0}); break;
+      case json::parse_event_t::array_start: frames_.push_back(Frame{false, {}, "", 0}); break;
+      case json::parse_event_t::key: {
+        Frame& f = frames_.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          ctx.fail(path(), "written twice in one object (JSON would keep only the last silently)");
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames_.pop_back();
+        done();
+        break;
+      case json::parse_event_t::value: done(); break;
+    }
+  }
+
+ private:
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;  // objects: the key of the member being parsed
+    size_t index;     // arrays: the index of the element being parsed
+  };
+  void done() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+  }
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : frames_) p = f.object ? childKey(p, f.key) : indexKey(p, f.index);
+    return p;
+  }
+  std::vector<Frame> frames_;
+};
+
 std::string parseMessage(const json::exception& e) {
   // Drop nlohmann's "[json.exception.parse_error.101] " tag; keep its line/column text.
   const std::string what = e.what();
@@ -355,9 +398,11 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
   try {
     // Scenes nest 5 levels (primitives[i].transform.position[j]). nlohmann's copy and dump recurse
     // once per level, so a document nested thousands deep would overflow the stack later on.
-    doc = json::parse(jsonText, [&ctx](int depth, json::parse_event_t, json&) {
+    DuplicateKeys duplicates;
+    doc = json::parse(jsonText, [&ctx, &duplicates](int depth, json::parse_event_t event, json& parsed) {
       if (depth > kMaxJsonDepth)
         ctx.fail("", "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels (a scene needs 5)");
+      duplicates.see(ctx, event, parsed);
       return true;
     });
   } catch (const json::exception& e) {  // parse_error, and out_of_range for 1e999

@@ -673,6 +673,28 @@ TEST_F(SceneFiles, DataDirFromTheEnvironment) {
   }
 }
 
+// A key written twice in one object fails naming its path (JSON parsers keep one silently); the
+// same key in two objects, or in two elements of an array, is not a duplicate.
+TEST(SceneLoad, DuplicateKeysFailNamingThem) {
+  const std::string scene = minimalScene().dump();
+  auto withRenderer = [&](const std::string& renderer) {
+    json j = minimalScene();
+    j.erase("renderer");
+    return j.dump().substr(0, j.dump().size() - 1) + ", \"renderer\": " + renderer + "}";
+  };
+  EXPECT_EQ(errorOfText(withRenderer(R"({"resolution": [4, 4], "spp": 1, "spp": 1000})")),
+            "s.json: renderer.spp: written twice in one object (JSON would keep only the last silently)");
+  EXPECT_EQ(errorOfText("{\"background\": [0, 0, 0], " + scene.substr(1, scene.size() - 2) +
+                        ", \"background\": [1, 1, 1]}"),
+            "s.json: background: written twice in one object (JSON would keep only the last silently)");
+  std::string text = scene;
+  const std::string fog = "\"name\":\"fog\"";
+  ASSERT_NE(text.find(fog), std::string::npos);
+  text.insert(text.find(fog), "\"g\":0.5,\"g\":0.6,");
+  EXPECT_EQ(errorOfText(text), "s.json: materials[1].g: written twice in one object (JSON would keep only the last silently)");
+  EXPECT_EQ(errorOfText(scene), "(no error)");  // "name" in every material, "position" in every transform
+}
+
 TEST_F(SceneFiles, BadVolumePaths) {
   touch("grids/a.vdb");
   const std::string prefix = scenePath() + ": materials[1].path: ";
