@@ -60,6 +60,10 @@ std::string oneLine(const char* what) {
 
 namespace {
 
+// What a file OpenVDB cannot read is: its own messages ("iostream error", "Map is not registered")
+// do not say.
+const std::string kUnreadable = "not a readable OpenVDB file: truncated, corrupt or of another format";
+
 // A missing or unreadable file gets a plain message before OpenVDB sees it (its own messages name
 // a temporary copy or nothing at all).
 void requireReadableFile(const std::string& path) {
@@ -90,7 +94,7 @@ std::vector<GridEntry> listGrids(openvdb::io::File& file, const std::string& pat
       out.push_back({g->getName(), g->valueType(), g->isType<openvdb::FloatGrid>()});
     }
   } catch (const std::exception& e) {
-    throw inputError(path, "", "not a readable OpenVDB file (" + oneLine(e.what()) + ")");
+    throw inputError(path, "", kUnreadable + " (OpenVDB: " + oneLine(e.what()) + ")");
   }
   return out;
 }
@@ -245,7 +249,7 @@ std::vector<GridInfo> describeVdbGrids(const std::string& path) {
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
-    throw inputError(path, "", "not a readable OpenVDB file (" + oneLine(e.what()) + ")");
+    throw inputError(path, "", kUnreadable + " (OpenVDB: " + oneLine(e.what()) + ")");
   }
   for (const openvdb::GridBase::Ptr& g : *grids) {
     GridInfo info;

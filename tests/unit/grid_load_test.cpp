@@ -269,11 +269,22 @@ TEST(VdbErrors, MissingAndNonVdbFiles) {
   const std::string text = dir.file("text.vdb");
   writeFile(text, "this is not a vdb file at all, just some text\n");
   const std::string msg = inputErrorOf([&] { narval::loadVdb(text, "density"); });
-  EXPECT_EQ(msg.rfind(text + ": not a readable OpenVDB file (", 0), 0u) << msg;
+  const std::string unreadable = ": not a readable OpenVDB file: truncated, corrupt or of another format (OpenVDB: ";
+  EXPECT_EQ(msg.rfind(text + unreadable, 0), 0u) << msg;
   const std::string empty = dir.file("empty.vdb");
   writeFile(empty, "");
   const std::string msg2 = inputErrorOf([&] { narval::loadVdb(empty, "density"); });
-  EXPECT_EQ(msg2.rfind(empty + ": not a readable OpenVDB file (", 0), 0u) << msg2;
+  EXPECT_EQ(msg2.rfind(empty + unreadable, 0), 0u) << msg2;
+  // A real file cut short inside its grid says so.
+  const std::string whole = dir.file("whole.vdb"), cut = dir.file("cut.vdb");
+  narval::writeVdb(whole, paddedGrid(4, 4, 4, 1, 1, 1));
+  const std::string bytes = narval::test::readFile(whole);
+  for (size_t n : {bytes.size() / 2, bytes.size() - 10}) {
+    writeFile(cut, bytes.substr(0, n));
+    EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(cut, "density"); }),
+              cut + ": grid: cannot read 'density' (the file is truncated or corrupt: a read ran past its end)")
+        << n << " bytes";
+  }
 }
 
 TEST(VdbErrors, NonFloatGridsAreNamedAsSuch) {
