@@ -20,7 +20,7 @@ namespace narval {
 namespace {
 
 struct ViewArgs {
-  std::string scene, algorithm, device, reference, resolution, script, screenshot, outputDir = ".", statsJson;
+  std::string scene, algorithm, device, reference, resolution, script, screenshot, outputDir = "out", statsJson;
   std::string localSize = "8x8";
   std::vector<std::string> sets;
   double targetMs = 50;
@@ -140,7 +140,7 @@ Command addViewCommand(CLI::App& app) {
   sub->add_option("--frames", a->frames, "Stop after N frames (default with --script: the script's frames)")
       ->check(atLeast(1));
   sub->add_option("--screenshot", a->screenshot, "Save the window's last frame as PNG");
-  sub->add_option("--output-dir", a->outputDir, "Where P writes its EXR, PNG and scene JSON (default .)");
+  sub->add_option("--output-dir", a->outputDir, "Where P writes its EXR, PNG and scene JSON (default out/, as scripts/render.sh)");
   sub->add_option("--stats-json", a->statsJson, "Write frame counts per resolution and the last frame's time");
   sub->add_option("--local-size", a->localSize, "Work-group shape WxH (default 8x8); never changes the pixels");
   addThreadsOption(sub);

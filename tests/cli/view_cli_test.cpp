@@ -94,6 +94,16 @@ TEST_F(ViewCli, SnapshotsAreWhatRenderDrawsFromTheirJson) {
   EXPECT_EQ(readFile(dir_ / "shot.png"), readFile(dir_ / "again_003.png"));
 }
 
+// Without --output-dir, P writes into out/ (made then), never beside the user's files.
+TEST_F(ViewCli, SnapshotsGoToOutByDefault) {
+  write("p.txt", "frames 1\nkey P\nframes 1\n");
+  const RunResult v = run("view fog.json --script p.txt --target-ms 1e9", kXvfb);
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_NE(v.out.find("narval view: wrote out/fog_view_001.exr, .png and .json"), std::string::npos) << v.out;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "fog_view_001.exr"));
+  EXPECT_FALSE(fs::exists(dir_ / "fog_view_001.exr"));
+}
+
 TEST_F(ViewCli, MovingFramesAreSmallerAndCountedPerResolution) {
   write("moves.txt",
         "frames 2\n"
