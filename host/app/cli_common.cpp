@@ -1,13 +1,16 @@
 #include "app/cli_common.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <regex>
 
 #include "core/atomic_file.h"
 #include "core/input_error.h"
+#include "scene/json_reader.h"
 
 namespace narval {
 
@@ -49,7 +52,11 @@ CLI::Validator atLeast(long long min) {
       [min](std::string& text) -> std::string {
         long long v = 0;
         if (!parseInteger(text, &v)) return "expected an integer, got '" + text + "'";
-        return v < min ? "must be at least " + std::to_string(min) + ", got " + text : std::string();
+        if (v < min) return "must be at least " + std::to_string(min) + ", got " + text;
+        // The options it checks are ints: a larger value would fail CLI11's conversion, unnamed.
+        if (v > std::numeric_limits<int>::max())
+          return "must be at most " + std::to_string(std::numeric_limits<int>::max()) + ", got " + text;
+        return std::string();
       },
       "INT >= " + std::to_string(min));
 }
@@ -124,6 +131,37 @@ void checkLocalSize(int lx, int ly, const cl::Device& device, const std::string&
     if (size_t(i == 0 ? lx : ly) > sides[i])
       throw inputError("--local-size", "", shape + ": " + deviceName + " takes at most " + std::to_string(sides[i]) +
                                                " work-items along " + (i == 0 ? "x" : "y"));
+}
+
+std::string unknownFlag(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* sub = nullptr;
+  for (const CLI::App* c : app.get_subcommands())
+    if (c->parsed()) sub = c;
+  std::vector<std::string> names;  // the command's long flags, without their dashes
+  if (sub)
+    for (const CLI::Option* o : sub->get_options())
+      for (const std::string& n : o->get_lnames()) names.push_back(n);
+  const std::string help = sub ? "narval " + sub->get_name() + " --help" : "narval --help";
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.size() < 2 || arg[0] != '-' || std::isdigit(static_cast<unsigned char>(arg[1])) || arg[1] == '.')
+      continue;  // a value ("--exposure -2"), not a flag
+    const std::string bare = arg.substr(arg.find_first_not_of('-'), arg.find('=') - arg.find_first_not_of('-'));
+    bool known = false, singleDash = arg[1] != '-';
+    std::string meant;
+    for (const std::string& n : names) {
+      if (n == bare) known = !singleDash, meant = n;
+      if (meant.empty() && (scene_detail::nearMiss(bare, n) || (bare.size() >= 3 && n.rfind(bare, 0) == 0))) meant = n;
+    }
+    if (known || (!singleDash && arg.size() == 2)) continue;
+    if (singleDash && sub)  // -q and other one-letter flags are the parser's; "-spp" is a typo
+      for (const CLI::Option* o : sub->get_options())
+        for (const std::string& n : o->get_snames())
+          if (arg == "-" + n) known = true;
+    if (known) continue;
+    return arg + ": unknown flag" + (meant.empty() ? " (see " + help + ")" : " (did you mean --" + meant + "?)");
+  }
+  return "";
 }
 
 }  // namespace narval

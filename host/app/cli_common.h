@@ -29,6 +29,10 @@ std::string resolutionOverride(const std::string& text);
 // not CLI11's range text with a 309-digit bound.
 CLI::Validator atLeast(long long min);
 CLI::Validator between(long long min, long long max);
+// The first flag of argv that the parsed command does not take, with the flag it probably meant
+// ("-spp", "--res" for --resolution, a near miss), as one line; "" when every flag is known. Asked
+// when CLI11 refuses the arguments: it names a mistyped required flag as missing instead.
+std::string unknownFlag(const CLI::App& app, int argc, char** argv);
 CLI::Validator greaterThanZero();  // any finite number > 0
 
 // --threads N on a subcommand that opens a device: PoCL's worker threads on a CPU device (it sets

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <vector>
 
+#include "app/cli_common.h"
 #include "app/commands.h"
 #include "cl/cl_runtime.h"
 #include "core/input_error.h"
@@ -31,7 +32,8 @@ int main(int argc, char** argv) {
     std::cerr << "narval: " << e.what() << "\n";
     return 2;
   } catch (const CLI::ParseError& e) {
-    std::cerr << "narval: " << e.what() << " (see narval --help)\n";
+    const std::string unknown = narval::unknownFlag(app, argc, argv);
+    std::cerr << "narval: " << (unknown.empty() ? std::string(e.what()) + " (see narval --help)" : unknown) << "\n";
     return 2;
   }
   try {

@@ -47,6 +47,19 @@ TEST_F(FlagsCli, OutOfRangeValuesReadLikeTheSceneLoader) {
   expectRefused("view s.json --target-ms -5", "narval: --target-ms: must be a finite number greater than 0, got -5\n");
 }
 
+// A number beyond an int names the limit (not CLI11's "Could not convert"); a flag the command does
+// not take names the one probably meant: a single dash, a prefix, a near miss.
+TEST_F(FlagsCli, UnknownFlagsSuggestAndHugeNumbersNameTheLimit) {
+  expectRefused("render s.json --spp 1000000000000", "narval: --spp: must be at most 2147483647, got 1000000000000\n");
+  expectRefused("render s.json -spp 4", "narval: -spp: unknown flag (did you mean --spp?)\n");
+  expectRefused("render s.json --res 16x12", "narval: --res: unknown flag (did you mean --resolution?)\n");
+  expectRefused("render s.json --sp 4", "narval: --sp: unknown flag (did you mean --spp?)\n");
+  expectRefused("render s.json --exposure -2 --zzz 1", "narval: --zzz: unknown flag (see narval render --help)\n");
+  expectRefused("render s.json extra", "narval: The following argument was not expected: extra (see narval --help)\n");
+  // A mistyped required flag: named as the typo it is, not as a missing flag.
+  expectRefused("farm s.json --tasks 2 --schedular local", "narval: --schedular: unknown flag (did you mean --scheduler?)\n");
+}
+
 // --spp has no meaning for the real-time algorithms (one estimate per pixel per frame); --bounces
 // has one only for the ray marcher's multiple-scattering cache, whose paths take the scene's bounces.
 TEST_F(FlagsCli, SamplesAndBouncesOnlyWhereTheyApply) {
