@@ -46,9 +46,19 @@ std::string lowercase(std::string s) {
 }
 }  // namespace
 
+// Other renderers' and papers' words for narval's keys (lower case): taken for the key as a typo is.
+const std::pair<const char*, const char*> kSynonyms[] = {
+    {"samples", "spp"},        {"samplesperpixel", "spp"}, {"maxdepth", "bounces"},   {"maxbounces", "bounces"},
+    {"depth", "bounces"},      {"fov", "vfov"},            {"phase", "phaseFunction"}, {"anisotropy", "g"},
+    {"sigma_s", "scattering"}, {"sigma_a", "absorption"},  {"filename", "path"},
+    {"file", "path"},          {"target", "lookAt"},       {"look_at", "lookAt"},     {"tonemap", "toneMapping"}};
+
 bool isTypoOf(const std::string& unknown, const std::string& name) {
-  return unknown != name && nearMiss(unknown, name) &&
-         (std::min(unknown.size(), name.size()) >= 3 || lowercase(unknown) == lowercase(name));
+  if (unknown == name) return false;
+  for (const auto& [word, key] : kSynonyms)
+    if (lowercase(unknown) == word && name == key) return true;
+  return nearMiss(unknown, name) &&
+         (std::max(unknown.size(), name.size()) >= 3 || lowercase(unknown) == lowercase(name));
 }
 
 bool nearMiss(const std::string& a, const std::string& b) {

@@ -42,7 +42,8 @@ std::string schemaKey(const std::string& key);
 // replaced, or two neighbours swapped), after case is ignored.
 bool nearMiss(const std::string& a, const std::string& b);
 // An unknown key that is taken for a typo of `name`: a near miss, by case at any length, by one
-// edit only when both have three letters or more ("x" is not a misspelt "g").
+// edit when the longer of the two has three letters or more ("sp" for "spp"; "x" is not a misspelt
+// "g"), or another renderer's word for it ("samples" for "spp", "maxDepth" for "bounces").
 bool isTypoOf(const std::string& unknown, const std::string& name);
 
 // A float as the messages print it: the shortest form that reads back (1.5, 0.0001, 1e+20).

@@ -408,8 +408,8 @@ TEST(SceneWarnings, UnknownKeysAreNamedAndIgnored) {
 
 // A key one slip away from a key its object takes is a typo whose default would run silently (a
 // thousand samples for "sPP"): an error naming the key it probably meant. Case slips count at any
-// length, one edit (a letter added, dropped, replaced, or two swapped) only for names of three
-// letters or more; anything further stays a warning.
+// length, one edit (a letter added, dropped, replaced, or two swapped) when the longer name has three
+// letters or more, and other renderers' words for a key; anything further stays a warning.
 TEST(SceneErrors, NearMissKeysNameTheKeyTheyProbablyMeant) {
   auto with = [](const std::string& object, int index, const std::string& key) {
     json j = minimalScene();
@@ -425,6 +425,11 @@ TEST(SceneErrors, NearMissKeysNameTheKeyTheyProbablyMeant) {
   EXPECT_EQ(with("materials", 1, "densty"), "s.json: materials[1].densty: unknown key (did you mean materials[1].density?)");
   EXPECT_EQ(with("materials", 1, "G"), "s.json: materials[1].G: unknown key (did you mean materials[1].g?)");
   EXPECT_EQ(with("materials", 1, "h"), "(no error)");  // one edit from "g", but one letter long
+  EXPECT_EQ(with("renderer", -1, "sp"), "s.json: renderer.sp: unknown key (did you mean renderer.spp?)");
+  EXPECT_EQ(with("renderer", -1, "samples"), "s.json: renderer.samples: unknown key (did you mean renderer.spp?)");
+  EXPECT_EQ(with("renderer", -1, "maxDepth"), "s.json: renderer.maxDepth: unknown key (did you mean renderer.bounces?)");
+  EXPECT_EQ(with("materials", 1, "sigma_s"),
+            "s.json: materials[1].sigma_s: unknown key (did you mean materials[1].scattering?)");
   EXPECT_EQ(with("camera", -1, "fovy"), "(no error)");  // two edits from "vfov"
   // A required key misspelt: the missing key's message points at the one present.
   json j = minimalScene();
