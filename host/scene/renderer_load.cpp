@@ -145,7 +145,12 @@ RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::st
                                   s.octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::None);
   if (s.octaves > 1 && s.multipleScattering != MultipleScattering::Octaves)
     ctx.fail(m.keyOf("octaves"), "applies only with multipleScattering \"octaves\"");
-  if (const json* c = m.find("msCache")) s.msCache = readMsCache(ctx, *c, m.keyOf("msCache"), s.msCache);
+  if (const json* c = m.find("msCache")) {
+    s.msCache = readMsCache(ctx, *c, m.keyOf("msCache"), s.msCache);
+    if (s.multipleScattering != MultipleScattering::Cache)
+      ctx.warn(m.keyOf("msCache"), std::string("applies to multipleScattering \"cache\"; \"") +
+                                       enumName(kMultipleScattering, s.multipleScattering) + "\" ignores it");
+  }
   m.reportUnknown();
   return s;
 }

@@ -438,6 +438,17 @@ TEST(SceneErrors, NearMissKeysNameTheKeyTheyProbablyMeant) {
   EXPECT_EQ(errorOf(j), "s.json: materials[1].scattering: missing required key (is \"Scattering\" meant to be it?)");
 }
 
+// The multiple-scattering cache's settings without the cache are said to be ignored.
+TEST(SceneWarnings, MsCacheSettingsWithoutTheCache) {
+  json j = minimalScene();
+  j["renderer"]["raymarch"] = {{"msCache", {{"paths", 64}}}};
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
+            (std::vector<std::string>{"s.json: renderer.raymarch.msCache: applies to multipleScattering \"cache\"; "
+                                      "\"none\" ignores it"}));
+  j["renderer"]["raymarch"]["multipleScattering"] = "cache";
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings, std::vector<std::string>{});
+}
+
 // A grid named or placed on a medium without a grid file has nothing to act on.
 TEST(SceneWarnings, GridKeysOnAHomogeneousMedium) {
   json j = minimalScene();
