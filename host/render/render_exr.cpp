@@ -46,14 +46,53 @@ long long attributeNumber(const std::map<std::string, std::string>& attrs, const
 
 }  // namespace
 
-std::string renderKey(const Scene& scene) {
+nlohmann::json renderSettings(const Scene& scene) {
   nlohmann::json doc = scene.document;
   if (doc.contains("renderer") && doc["renderer"].is_object())
     for (const char* k : {"spp", "HDR", "toneMapping", "exposure", "raymarch", "lobe"}) doc["renderer"].erase(k);
   if (doc.contains("camera") && doc["camera"].is_object()) doc["camera"].erase("speed");
+  return doc;
+}
+
+std::string renderKey(const Scene& scene) {
   char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)fnv1a64(doc.dump()));
+  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)fnv1a64(renderSettings(scene).dump()));
   return hex;
+}
+
+namespace {
+
+// The first leaf (depth first, keys in order) where a (from `as`) and b (from `bs`) differ, at `path`.
+std::string firstDifference(const nlohmann::json& a, const nlohmann::json& b, const std::string& path,
+                            const std::string& as, const std::string& bs) {
+  if (a.is_object() && b.is_object()) {
+    for (const auto& [k, v] : a.items()) {
+      const std::string p = path.empty() ? k : path + "." + k;
+      if (!b.contains(k)) return p + " is " + v.dump() + " in " + as + ", absent in " + bs;
+      const std::string d = firstDifference(v, b[k], p, as, bs);
+      if (!d.empty()) return d;
+    }
+    for (const auto& [k, v] : b.items())
+      if (!a.contains(k)) return (path.empty() ? k : path + "." + k) + " is absent in " + as + ", " + v.dump() + " in " + bs;
+    return "";
+  }
+  if (a.is_array() && b.is_array() && a.size() == b.size()) {
+    for (size_t i = 0; i < a.size(); ++i) {
+      const std::string d = firstDifference(a[i], b[i], path + "[" + std::to_string(i) + "]", as, bs);
+      if (!d.empty()) return d;
+    }
+    return "";
+  }
+  return a == b ? "" : path + " is " + a.dump() + " in " + as + ", " + b.dump() + " in " + bs;
+}
+
+}  // namespace
+
+std::string settingsDifference(const std::string& a, const std::string& as, const std::string& b,
+                               const std::string& bs) {
+  const nlohmann::json x = nlohmann::json::parse(a, nullptr, false), y = nlohmann::json::parse(b, nullptr, false);
+  if (x.is_discarded() || y.is_discarded()) return "";
+  return firstDifference(x, y, "", as, bs);
 }
 
 namespace {
@@ -75,6 +114,7 @@ RenderIdentity renderIdentity(const Scene& scene) {
   id.seed = scene.renderer.seed;
   id.scene = scene.sourcePath;
   id.renderKey = renderKey(scene);
+  id.settings = renderSettings(scene).dump();
   id.exposure = scene.renderer.exposure;
   id.toneMapping = scene.renderer.toneMapping;
   id.overrides = scene.overrides;
@@ -110,7 +150,8 @@ std::vector<ExrAttribute> renderAttributes(const RenderStats& s, const RenderIde
           {"narval:tone_mapping", std::string(toneMappingName(id.toneMapping))},
           {"narval:version", std::string(NARVAL_VERSION)},
           {"narval:command_line", recordedCommandLine()},
-          {"narval:overrides", id.overrides}};
+          {"narval:overrides", id.overrides},
+          {"narval:settings", id.settings}};
   if (s.algorithm == "pathtrace") {
     attrs.push_back({"narval:sample_begin", s.sampleBegin});
     attrs.push_back({"narval:sample_end", s.sampleBegin + s.spp});
@@ -217,11 +258,16 @@ AccumulatorState readAccumulator(const std::string& path, const Scene& scene, in
                                               : "rendered by " + algorithm->second + "; only pathtrace renders resume");
   const auto key = attrs.find("narval:render_key");
   if (key == attrs.end()) throw inputError(path, "narval:render_key", "missing: not a resumable narval path-traced render");
-  if (key->second != renderKey(scene))
+  if (key->second != renderKey(scene)) {
+    const auto settings = attrs.find("narval:settings");
+    const std::string difference =
+        settings == attrs.end() ? ""
+                                : settingsDifference(settings->second, path, renderSettings(scene).dump(), "the scene");
     throw inputError(path, "narval:render_key",
-                     "rendered from other settings than " + scene.sourcePath +
-                         " with these options (only spp and display settings may change); render to another file "
-                         "or leave out --resume");
+                     "rendered from other settings than " + scene.sourcePath + " with these options" +
+                         (difference.empty() ? "" : " (" + difference + ")") +
+                         "; only spp and display settings may change: render to another file or leave out --resume");
+  }
   RenderPart part = readRenderPart(path);
   AccumulatorState& acc = part.accumulator;
   if (acc.begin != sampleBegin)

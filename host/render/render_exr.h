@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "image/image.h"
 #include "render/render_types.h"
 #include "scene/scene.h"
@@ -25,11 +27,21 @@ const std::string& recordedCommandLine();
 struct RenderIdentity {
   uint32_t seed = 0;
   std::string scene, renderKey;  // Scene::sourcePath; renderKey(scene)
+  std::string settings;           // renderSettings(scene).dump(): what the key hashes ("" unknown)
   float exposure = 0.0f;
   ToneMapping toneMapping = ToneMapping::Aces;
   std::vector<std::string> overrides;
 };
 RenderIdentity renderIdentity(const Scene& scene);
+
+// The settings a path-traced render's samples depend on (Scene::document less the display and
+// real-time keys): what renderKey hashes and narval:settings records.
+nlohmann::json renderSettings(const Scene& scene);
+// The first setting that differs between two renderSettings documents (as text), from `as` and `bs`:
+// "KEY is A in AS, B in BS" ("" when they agree or one is not JSON, e.g. a file from before the
+// attribute): what a refused --resume or merge names.
+std::string settingsDifference(const std::string& a, const std::string& as, const std::string& b,
+                               const std::string& bs);
 
 // The header attributes of a render's EXR, numbers typed as numbers: pbrt-v4's renderTimeSeconds (float)
 // and samplesPerPixel (int), which image tools read; OpenEXR's capDate ("YYYY:MM:DD hh:mm:ss", local) and

@@ -24,6 +24,7 @@ RenderIdentity mergedIdentity(const RenderPart& first, int spp) {
   id.seed = uint32_t(std::strtoull(first.attribute("narval:seed").c_str(), nullptr, 10));
   id.scene = first.attribute("narval:scene");
   id.renderKey = first.attribute("narval:render_key");
+  id.settings = first.attribute("narval:settings");
   id.exposure = std::strtof(first.attribute("narval:exposure").c_str(), nullptr);
   if (!toneMappingFromName(first.attribute("narval:tone_mapping"), &id.toneMapping))
     throw inputError(first.path, "narval:tone_mapping",
@@ -50,11 +51,18 @@ MergedRender mergeRenderParts(const std::vector<std::string>& paths) {
   for (const std::string& p : paths) parts.push_back(readRenderPartHeader(p));
   const RenderPart& first = parts.front();
   for (const RenderPart& p : parts) {
-    for (const std::string& key : kPartIdentityAttributes)
-      if (p.attribute(key) != first.attribute(key))
-        throw inputError(p.path, key,
-                         "'" + p.attribute(key) + "' where " + first.path + " has '" + first.attribute(key) +
-                             "': parts must come from one scene, settings, seed, device and narval version");
+    for (const std::string& key : kPartIdentityAttributes) {
+      if (p.attribute(key) == first.attribute(key)) continue;
+      // Another render key: the setting that differs, where both parts record their settings.
+      const std::string difference = key == "narval:render_key"
+                                         ? settingsDifference(first.attribute("narval:settings"), first.path,
+                                                              p.attribute("narval:settings"), "this part")
+                                         : "";
+      throw inputError(p.path, key,
+                       "'" + p.attribute(key) + "' where " + first.path + " has '" + first.attribute(key) + "'" +
+                           (difference.empty() ? "" : " (" + difference + ")") +
+                           ": parts must come from one scene, settings, seed, device and narval version");
+    }
     if (p.width != first.width || p.height != first.height)
       throw inputError(p.path, "narval:render_key",
                        std::to_string(p.width) + "x" + std::to_string(p.height) + " where " + first.path + " is " +

@@ -130,8 +130,9 @@ TEST_F(InterruptCli, ResumeRefusesAnotherScenesRenderAndLeavesItUntouched) {
   const RunResult r = run("render fog.json -o fog.exr --spp 16 --seed 8 --resume");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err,
-            "narval: fog.exr: narval:render_key: rendered from other settings than fog.json with these options (only "
-            "spp and display settings may change); render to another file or leave out --resume\n");
+            "narval: fog.exr: narval:render_key: rendered from other settings than fog.json with these options "
+            "(renderer.seed is 7 in fog.exr, 8 in the scene); only spp and display settings may change: render to "
+            "another file or leave out --resume\n");
   EXPECT_EQ(readFile(dir_ / "fog.exr"), before);
   // Display settings do not change the samples: resuming under another exposure is fine.
   EXPECT_EQ(run("render fog.json -o fog.exr --spp 12 --set renderer.exposure=3 --resume").code, 0);

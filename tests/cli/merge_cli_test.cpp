@@ -134,7 +134,8 @@ TEST_F(MergeCli, RefusalsNameThePartAndTheAttribute) {
   ASSERT_NE(key, otherKey);
   expectRefusal("a.exr seed9.exr c.exr",
                 "seed9.exr: narval:render_key: '" + otherKey + "' where a.exr has '" + key +
-                    "': parts must come from one scene, settings, seed, device and narval version");
+                    "' (renderer.seed is 7 in a.exr, 9 in this part): parts must come from one scene, settings, "
+                    "seed, device and narval version");
   // Another device or narval version: the same part with that attribute rewritten.
   const RenderPart b = readRenderPart(file("b.exr"));
   for (const char* attribute : {"narval:device", "narval:version"}) {
