@@ -48,7 +48,8 @@ std::string settingsDifference(const std::string& a, const std::string& as, cons
 // utcOffset (float s; UTC = local + utcOffset); narval's algorithm, spp, bounces, seed, scene, device,
 // seconds, status, render_key, majorant, majorant_resolution (what --resume checks), sample_begin and
 // sample_end (samples [begin, end), what `narval merge` tiles), exposure and tone_mapping (the display
-// transform `narval compare` applies by default), version, command_line, overrides (--set strings, a vector).
+// transform `narval compare` applies by default), version, command_line, overrides (--set strings, a vector),
+// settings (renderSettings as JSON: what a refused --resume or merge names the difference from).
 std::vector<ExrAttribute> renderAttributes(const RenderStats& stats, const RenderIdentity& identity);
 
 // Writes result.image to `path` (atomically) with renderAttributes and, for the path tracer, the
