@@ -8,23 +8,14 @@
 namespace narval {
 namespace {
 
-// The lobe variants' defaults where the scene leaves a key out (0); eq7's are the dissertation's.
-int lobeShadowAreaSamples(const LobeSettings& l) {
-  if (l.shadowAreaSamples > 0) return l.shadowAreaSamples;
+// A lobe key the scene left out (0) takes its variant's default; eq7's are the dissertation's.
+int lobeDefault(const LobeSettings& l, int value, int eq7, int corrected) {
+  if (value > 0) return value;
   switch (l.variant) {
-    case LobeVariant::Eq7: return 1;
-    case LobeVariant::Corrected: return 4;
+    case LobeVariant::Eq7: return eq7;
+    case LobeVariant::Corrected: return corrected;
   }
-  throw std::logic_error("lobeShadowAreaSamples: not a LobeVariant");
-}
-
-int lobeViewSteps(const LobeSettings& l) {
-  if (l.viewSteps > 0) return l.viewSteps;
-  switch (l.variant) {
-    case LobeVariant::Eq7: return 24;
-    case LobeVariant::Corrected: return 16;
-  }
-  throw std::logic_error("lobeViewSteps: not a LobeVariant");
+  throw std::logic_error("lobeDefault: not a LobeVariant");
 }
 
 int areaLightPhase(AreaLightPhase a) {
@@ -63,7 +54,7 @@ march_params raymarchMarch(const RaymarchSettings& r) {
 
 march_params lobeMarch(const LobeSettings& l) {
   return marchParams(l.firstHitSteps, l.shadowSteps, l.minTransmittance, l.areaLightSamples, l.areaLightPhase,
-                     lobeShadowAreaSamples(l));
+                     lobeDefault(l, l.shadowAreaSamples, 1, 4));
 }
 
 lobe_params lobeParams(const LobeSettings& l) {
@@ -71,7 +62,7 @@ lobe_params lobeParams(const LobeSettings& l) {
   p.depth_factor = l.depthFactor;
   p.radius = l.lobeRadius;
   p.points = l.lobePoints;
-  p.view_steps = lobeViewSteps(l);
+  p.view_steps = lobeDefault(l, l.viewSteps, 24, 16);
   p.variant = l.variant == LobeVariant::Corrected ? LOBE_CORRECTED : LOBE_EQ7;
   return p;
 }

@@ -49,7 +49,7 @@ std::string lowercase(std::string s) {
 // Other renderers' and papers' words for narval's keys (lower case): taken for the key as a typo is.
 const std::pair<const char*, const char*> kSynonyms[] = {
     {"samples", "spp"},        {"samplesperpixel", "spp"}, {"maxdepth", "bounces"},   {"maxbounces", "bounces"},
-    {"depth", "bounces"},      {"fov", "vfov"},            {"phase", "phaseFunction"}, {"anisotropy", "g"},
+    {"depth", "bounces"},      {"phase", "phaseFunction"}, {"anisotropy", "g"},
     {"sigma_s", "scattering"}, {"sigma_a", "absorption"},  {"filename", "path"},
     {"file", "path"},          {"target", "lookAt"},       {"look_at", "lookAt"},     {"tonemap", "toneMapping"}};
 

@@ -48,7 +48,7 @@
  * spacing. A node at 0 would pull the whole cell to 0, so R + floor is mixed,
  * floor = MS_CACHE_LOG_FLOOR × the cell's largest R, and taken off after. MS_CACHE_INTERPOLATION_LINEAR
  * mixes R and b (b/R = Σ w_k b_k / Σ w_k R_k): exact for a field linear along each axis, which the
- * geometric mean undershoots (AM–GM: 6% midway between nodes a factor 2 apart). Which is nearer depends
+ * geometric mean undershoots (the AM–GM inequality). Which is nearer depends
  * on the medium (bench/RESULTS.md).
  *
  * Direct (ms_cache_params.direct; closure camera or the view layout only): a node holds the whole

@@ -14,7 +14,7 @@
  * mean per unit density) is marched along it to its total τ_end (march_column_density,
  * MS_VIEW_PLACE_STEPS samples over occupied majorant cells) and cut where the transmittance has fallen to
  *   T_i = 1 − (1 − T_end)·i/nz,   i = 0 … nz,   T_end = max(e^{−τ_end}, MS_VIEW_T_MIN)
- * (levels stop at τ_max = −ln MS_VIEW_T_MIN, past which the pixel sees under 1% of the medium): node s is
+ * (levels stop at τ_max = −ln MS_VIEW_T_MIN, past which the pixel sees less than MS_VIEW_T_MIN of the medium): node s is
  * the slice [τ_s, τ_{s+1}], an equal share of what the pixel sees. A column meeting no density stores
  * τ = −1 and takes no paths.
  *

@@ -17,7 +17,7 @@
  * Each edge, a great-circle arc, is integrated along its chord (phase_polygon_edge): no trigonometry,
  * bounded at the pole (G/sin²θ → p(1)/2); close to the area integral for Listing 4.1's light (86° × 64°)
  * at g up to 0.9 and a 6-unit light 20 units away (bench/RESULTS.md; tests/unit/phase_polygon_test.cpp
- * within its 0.3%). Counter-clockwise about its inside, φ grows along an edge whose great circle has a
+ * within its tolerance). Counter-clockwise about its inside, φ grows along an edge whose great circle has a
  * on its inner side; the contour counts ∫ G dφ from θ = 0 outwards: the polygon's integral when it
  * holds a or neither pole. */
 #ifndef NARVAL_PHASE_POLYGON_H
