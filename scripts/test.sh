@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# scripts/test.sh: set up, then run the whole ctest suite (output shown on failure), then fuzz the
-# scene and .vol parsers (scripts/fuzz.sh: $NARVAL_FUZZ_SECONDS per target, default 60, 0 skips).
+# scripts/test.sh [CTEST ARGS]: set up, then run the whole ctest suite (output shown on failure), then
+# fuzz the scene and .vol parsers (scripts/fuzz.sh: $NARVAL_FUZZ_SECONDS per target, default 60, 0
+# skips). With arguments, ctest gets them and the fuzzing is left out: `scripts/test.sh -L unit` is
+# the quick subset (labels: unit, device, render, cli, farm, docs).
 # The farm tests use Open Job Description's runner, `openjd` from PyPI's openjd-cli: installed here
 # into a virtual environment under build/ (not a build dependency) and named by NARVAL_OPENJD.
 set -euo pipefail
@@ -14,4 +16,4 @@ fi
 export NARVAL_OPENJD="$PWD/$openjd_venv/bin/openjd"
 jobs=$(nproc 2>/dev/null || echo 2)
 ctest --test-dir build --output-on-failure -j"$jobs" "$@"
-scripts/fuzz.sh
+if [ $# -eq 0 ]; then scripts/fuzz.sh; fi

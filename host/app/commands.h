@@ -22,5 +22,6 @@ Command addViewCommand(CLI::App& app);
 Command addInfoCommand(CLI::App& app);
 Command addMergeCommand(CLI::App& app);
 Command addFarmCommand(CLI::App& app);
+Command addSceneCommand(CLI::App& app);
 
 }  // namespace narval

@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
                                                  narval::addMakeCloudCommand(app), narval::addCompareCommand(app),
                                                  narval::addSweepCommand(app),
                                                  narval::addViewCommand(app), narval::addInfoCommand(app),
-                                                 narval::addMergeCommand(app), narval::addFarmCommand(app)};
+                                                 narval::addMergeCommand(app), narval::addFarmCommand(app),
+                                                 narval::addSceneCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

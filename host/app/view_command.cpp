@@ -136,7 +136,7 @@ Command addViewCommand(CLI::App& app) {
                   "long (default 50)")
       ->check(greaterThanZero());
   sub->add_option("--script", a->script,
-                  "Replay the inputs in FILE instead of a user (key, drag, scroll, hold, frames; README)");
+                  "Replay the inputs in FILE instead of a user (key, drag, scroll, hold, frames; docs/viewer.md)");
   sub->add_option("--frames", a->frames, "Stop after N frames (default with --script: the script's frames)")
       ->check(atLeast(1));
   sub->add_option("--screenshot", a->screenshot, "Save the window's last frame as PNG");

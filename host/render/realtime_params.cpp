@@ -8,16 +8,6 @@
 namespace narval {
 namespace {
 
-// A lobe key the scene left out (0) takes its variant's default; eq7's are the dissertation's.
-int lobeDefault(const LobeSettings& l, int value, int eq7, int corrected) {
-  if (value > 0) return value;
-  switch (l.variant) {
-    case LobeVariant::Eq7: return eq7;
-    case LobeVariant::Corrected: return corrected;
-  }
-  throw std::logic_error("lobeDefault: not a LobeVariant");
-}
-
 int areaLightPhase(AreaLightPhase a) {
   switch (a) {
     case AreaLightPhase::Points: return AREA_LIGHT_POINTS;
@@ -54,7 +44,7 @@ march_params raymarchMarch(const RaymarchSettings& r) {
 
 march_params lobeMarch(const LobeSettings& l) {
   return marchParams(l.firstHitSteps, l.shadowSteps, l.minTransmittance, l.areaLightSamples, l.areaLightPhase,
-                     lobeDefault(l, l.shadowAreaSamples, 1, 4));
+                     lobeShadowAreaSamples(l));
 }
 
 lobe_params lobeParams(const LobeSettings& l) {
@@ -62,7 +52,7 @@ lobe_params lobeParams(const LobeSettings& l) {
   p.depth_factor = l.depthFactor;
   p.radius = l.lobeRadius;
   p.points = l.lobePoints;
-  p.view_steps = lobeDefault(l, l.viewSteps, 24, 16);
+  p.view_steps = lobeViewSteps(l);
   p.variant = l.variant == LobeVariant::Corrected ? LOBE_CORRECTED : LOBE_EQ7;
   return p;
 }

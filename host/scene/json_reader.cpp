@@ -20,6 +20,23 @@ void JsonContext::warn(const std::string& key, const std::string& what) const {
   warnings->push_back(inputError(file, key, what).what());
 }
 
+bool JsonContext::changed(const std::string& key) const {
+  const auto it = keys.find(key);
+  if (it == keys.end() || !it->second.given) return false;
+  // JSON compares 4 and 4.0 as equal numbers. A key with no default (an object) is changed by its keys.
+  return !it->second.fallback.is_null() && *it->second.given != it->second.fallback;
+}
+
+bool JsonContext::changedUnder(const std::string& key) const {
+  for (auto it = keys.lower_bound(key + "."); it != keys.end() && it->first.rfind(key + ".", 0) == 0; ++it)
+    if (changed(it->first)) return true;
+  return false;
+}
+
+void JsonContext::warnIfChanged(const std::string& key, const std::string& what) const {
+  if (changed(key)) warn(key, what);
+}
+
 std::string childKey(const std::string& parent, const std::string& name) {
   return parent.empty() ? name : parent + "." + name;
 }
@@ -79,6 +96,10 @@ std::string formatNumber(float v) {
   if (v == std::floor(v) && std::fabs(v) < 1e9f) return std::to_string(static_cast<long long>(v));
   return formatShortest(v);
 }
+
+json jsonNumber(float v) { return json::parse(formatNumber(v)); }
+
+json jsonVec3(const Vec3f& v) { return json::array({jsonNumber(v[0]), jsonNumber(v[1]), jsonNumber(v[2])}); }
 
 namespace {
 
@@ -144,13 +165,25 @@ bool ObjectReader::has(const std::string& name) const { return value_.contains(n
 
 const json* ObjectReader::find(const std::string& name) {
   known_.push_back(name);
-  if (ctx_.keysAsked) ctx_.keysAsked->insert(schemaKey(keyOf(name)));
   const auto it = value_.find(name);
-  return it == value_.end() ? nullptr : &*it;
+  const json* v = it == value_.end() ? nullptr : &*it;
+  ctx_.keys[keyOf(name)].given = v;
+  return v;
 }
+
+void ObjectReader::note(const std::string& name, const std::string& type, const json& fallback,
+                        const std::string& range) {
+  KeyRecord& k = ctx_.keys[keyOf(name)];
+  if (!type.empty()) k.type = type;
+  if (!fallback.is_null()) k.fallback = fallback;
+  if (!range.empty()) k.range = range;
+}
+
+void ObjectReader::noteRange(const std::string& name, const std::string& range) { note(name, "", nullptr, range); }
 
 const json& ObjectReader::require(const std::string& name) {
   const json* v = find(name);
+  ctx_.keys[keyOf(name)].required = true;
   if (!v) {
     for (const auto& item : value_.items())
       if (isTypoOf(item.key(), name))
@@ -168,39 +201,50 @@ std::string ObjectReader::nearMissOf(const std::string& unknown) const {
 
 float ObjectReader::getFloat(const std::string& name, float fallback) {
   const json* v = find(name);
+  note(name, "number", jsonNumber(fallback));
   return v ? toFloat(ctx_, *v, keyOf(name)) : fallback;
 }
 
 float ObjectReader::requireFloat(const std::string& name) {
-  return toFloat(ctx_, require(name), keyOf(name));
+  const json& v = require(name);
+  note(name, "number", nullptr);
+  return toFloat(ctx_, v, keyOf(name));
 }
 
 int64_t ObjectReader::getInteger(const std::string& name, int64_t fallback) {
   const json* v = find(name);
+  note(name, "integer", fallback);
   return v ? toInteger(ctx_, *v, keyOf(name)) : fallback;
 }
 
 bool ObjectReader::getBool(const std::string& name, bool fallback) {
   const json* v = find(name);
+  note(name, "boolean", fallback);
   return v ? toBool(ctx_, *v, keyOf(name)) : fallback;
 }
 
 std::string ObjectReader::getString(const std::string& name, const std::string& fallback) {
   const json* v = find(name);
+  note(name, "string", fallback);
   return v ? toString(ctx_, *v, keyOf(name)) : fallback;
 }
 
 std::string ObjectReader::requireString(const std::string& name) {
-  return toString(ctx_, require(name), keyOf(name));
+  const json& v = require(name);
+  note(name, "string", nullptr);
+  return toString(ctx_, v, keyOf(name));
 }
 
 Vec3f ObjectReader::getVec3(const std::string& name, const Vec3f& fallback) {
   const json* v = find(name);
+  note(name, "[3 numbers]", jsonVec3(fallback));
   return v ? toVec3(ctx_, *v, keyOf(name)) : fallback;
 }
 
 Vec3f ObjectReader::requireVec3(const std::string& name) {
-  return toVec3(ctx_, require(name), keyOf(name));
+  const json& v = require(name);
+  note(name, "[3 numbers]", nullptr);
+  return toVec3(ctx_, v, keyOf(name));
 }
 
 void ObjectReader::reportUnknown() {
@@ -231,17 +275,20 @@ int64_t checkIntRange(const JsonContext& ctx, const std::string& key, int64_t v,
 }
 
 int readInt(ObjectReader& r, const std::string& name, int fallback, int64_t lo, int64_t hi) {
+  r.noteRange(name, hi == kIntMax ? ">= " + std::to_string(lo) : "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   return static_cast<int>(checkIntRange(r.context(), r.keyOf(name), r.getInteger(name, fallback), lo, hi));
 }
 
 float readNonNegative(ObjectReader& r, const std::string& name, float fallback) {
   const float v = r.getFloat(name, fallback);
+  r.noteRange(name, ">= 0");
   checkNonNegative(r.context(), r.keyOf(name), v);
   return v;
 }
 
 float readUnitInterval(ObjectReader& r, const std::string& name, float fallback) {
   const float v = r.getFloat(name, fallback);
+  r.noteRange(name, "[0, 1]");
   if (!(v >= 0 && v <= 1)) r.context().fail(r.keyOf(name), "must be in [0, 1], got " + formatNumber(v));
   return v;
 }

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <set>
 #include <string>
 #include <utility>
@@ -20,19 +21,39 @@ namespace narval::scene_detail {
 
 using json = nlohmann::json;
 
+// What the loader knows of one key it looked up: the scene's schema, learnt as it reads
+// (`narval scene --keys`), and the default that fills in a key left out (`--resolved`).
+struct KeyRecord {
+  std::string type;   // "number", "integer", "boolean", "string", "[3 numbers]", ...; "" not typed here
+  std::string range;  // "[0, 1]", ">= 1", the allowed names; "" any
+  json fallback;      // the value taken when it is left out; null: required, or no value
+  bool required = false;
+  const json* given = nullptr;  // the scene's value, if it gives one
+};
+
 // Where messages go while one scene is read.
 struct JsonContext {
   std::string file;                      // the scene file's name as the user gave it
   std::vector<std::string>* warnings;    // Scene::warnings
   std::vector<std::string> unknownKeys;  // dotted paths of keys the schema did not ask for
-  std::set<std::string>* keysAsked = nullptr;  // when set: every key looked up, as schemaKey() writes it
+  std::map<std::string, KeyRecord> keys;  // every key looked up, by its dotted path
+  bool checkFiles = true;                 // false: volume paths are not looked for (the key table)
   // Unknown keys that are near misses of a key their object asked for: (key, the key it probably
   // meant), both dotted. The loader fails on the first once the whole scene is read.
   std::vector<std::pair<std::string, std::string>> nearMisses;
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
   void warn(const std::string& key, const std::string& what) const;
+  // Warns "KEY: what" when the scene sets the key to something other than its default: a setting
+  // that cannot apply is named, while a resolved scene (every default written out) stays quiet.
+  // Whether the scene sets the key (or, for changedUnder, any key below it) away from its default.
+  bool changed(const std::string& key) const;
+  bool changedUnder(const std::string& key) const;
+  void warnIfChanged(const std::string& key, const std::string& what) const;
 };
+
+// The whole scene read through `ctx` (scene_load.cpp), which keeps what it learnt of every key.
+Scene parseScene(JsonContext& ctx, const std::string& jsonText, const std::vector<std::string>& overrides);
 
 std::string childKey(const std::string& parent, const std::string& name);  // "a" + "b" -> "a.b"
 std::string indexKey(const std::string& parent, size_t index);             // "a" + 1 -> "a[1]"
@@ -48,6 +69,8 @@ bool isTypoOf(const std::string& unknown, const std::string& name);
 
 // A float as the messages print it: the shortest form that reads back (1.5, 0.0001, 1e+20).
 std::string formatNumber(float v);
+json jsonNumber(float v);  // the same, as a JSON number
+json jsonVec3(const Vec3f& v);
 
 // Conversions of one value; `key` names it in messages.
 float toFloat(const JsonContext& ctx, const json& v, const std::string& key);         // finite
@@ -71,6 +94,9 @@ class ObjectReader {
   bool has(const std::string& name) const;
   const json* find(const std::string& name);     // nullptr when absent; marks the key as known
   const json& require(const std::string& name);  // "KEY: missing required key" when absent
+  // Records a key's type, default and range (KeyRecord); a field left empty keeps what it holds.
+  void note(const std::string& name, const std::string& type, const json& fallback, const std::string& range = "");
+  void noteRange(const std::string& name, const std::string& range);
 
   float getFloat(const std::string& name, float fallback);
   float requireFloat(const std::string& name);
@@ -107,12 +133,15 @@ E toEnum(const JsonContext& ctx, const json& v, const std::string& key, const En
 template <typename E>
 E readEnum(ObjectReader& r, const std::string& name, const EnumNames<E>& names, E fallback) {
   const json* v = r.find(name);
+  r.note(name, "string", enumName(names, fallback), enumNameList(names));
   return v ? toEnum(r.context(), *v, r.keyOf(name), names) : fallback;
 }
 
 template <typename E>
 E requireEnum(ObjectReader& r, const std::string& name, const EnumNames<E>& names) {
-  return toEnum(r.context(), r.require(name), r.keyOf(name), names);
+  const json& v = r.require(name);
+  r.note(name, "string", nullptr, enumNameList(names));
+  return toEnum(r.context(), v, r.keyOf(name), names);
 }
 
 // Range checks: the message names the value as the user wrote it.

@@ -35,9 +35,35 @@ const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corre
 const EnumNames<Algorithm> kAlgorithms = {ALGORITHMS(ALGORITHM_NAME)};
 #undef ALGORITHM_NAME
 
+const json kNoKeys = json::object();
+
+// A section of the renderer object, read whether given or not: every key of it gets its default
+// (KeyRecord), which a resolved scene writes out.
+const json& section(ObjectReader& r, const std::string& name) {
+  const json* v = r.find(name);
+  r.note(name, "object", nullptr);
+  return v ? *v : kNoKeys;
+}
+
+// Sections set for an algorithm that does not read them: named, since nothing would change.
+void warnSectionsThatDoNotApply(const JsonContext& ctx, const ObjectReader& r, const RendererSettings& s) {
+  const std::string algorithm = algorithmName(s.algorithm);
+  const bool cache = s.algorithm == Algorithm::Raymarch && s.raymarch.multipleScattering == MultipleScattering::Cache;
+  auto ignored = [&](const char* name, bool applies, const std::string& to) {
+    if (!applies && ctx.changedUnder(r.keyOf(name)))
+      ctx.warn(r.keyOf(name), "applies to " + to + "; algorithm \"" + algorithm + "\" ignores it");
+  };
+  ignored("pathtrace", s.algorithm == Algorithm::Pathtrace || cache,
+          "the path tracer and the ray marcher's multiple-scattering cache");
+  ignored("raymarch", s.algorithm == Algorithm::Raymarch, "algorithm \"raymarch\"");
+  ignored("lobe", s.algorithm == Algorithm::Lobe, "algorithm \"lobe\"");
+  ignored("lightCache", isRealtime(s.algorithm), "the real-time algorithms");
+}
+
 // A transmittance below which a march stops: [0, 1) (0 = never stops; 1 would stop at once).
 float readMinTransmittance(ObjectReader& r, float fallback) {
   const float v = r.getFloat("minTransmittance", fallback);
+  r.noteRange("minTransmittance", "[0, 1)");
   if (!(v >= 0 && v < 1))
     r.context().fail(r.keyOf("minTransmittance"), "must be in [0, 1) (0 = never stop), got " + formatNumber(v));
   return v;
@@ -46,13 +72,15 @@ float readMinTransmittance(ObjectReader& r, float fallback) {
 // renderer.raymarch/lobe.areaLightPhase; with "exact", a given areaLightSamples is said to be ignored.
 AreaLightPhase readAreaLightPhase(ObjectReader& r, AreaLightPhase fallback) {
   const AreaLightPhase v = readEnum(r, "areaLightPhase", kAreaLightPhases, fallback);
-  if (v == AreaLightPhase::Exact && r.find("areaLightSamples"))
-    r.context().warn(r.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
+  if (v == AreaLightPhase::Exact)
+    r.context().warnIfChanged(r.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
   return v;
 }
 
 ToneMapping readToneMapping(ObjectReader& r, ToneMapping fallback) {
   const json* v = r.find("toneMapping");
+  r.note("toneMapping", "boolean or string", enumName(kToneMappingNames, fallback),
+         "true (aces), false (none), " + enumNameList(kToneMappingNames));
   if (!v) return fallback;
   // Listing 4.1 writes a boolean; a name picks the operator.
   if (v->is_boolean()) return v->get<bool>() ? ToneMapping::Aces : ToneMapping::None;
@@ -65,6 +93,7 @@ ToneMapping readToneMapping(ObjectReader& r, ToneMapping fallback) {
 void readResolution(ObjectReader& r, RendererSettings& s) {
   const std::string key = r.keyOf("resolution");
   const json& v = r.require("resolution");
+  r.note("resolution", "[2 integers]", nullptr, "[1, " + std::to_string(kMaxImageSide) + "] each");
   if (!v.is_array() || v.size() != 2)
     r.context().fail(key, std::string("expected an array of 2 integers [width, height], got ") +
                               (v.is_array() ? std::to_string(v.size()) + " elements" : v.type_name()));
@@ -84,18 +113,12 @@ PathtraceSettings readPathtrace(JsonContext& ctx, const json& value, const std::
 
 MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::string& key, MsCacheSettings s) {
   ObjectReader mc(ctx, value, key);
-  s.closure = readEnum(mc, "closure", kMsCacheClosures, s.closure);
-  s.interpolation = readEnum(mc, "interpolation", kMsCacheInterpolations, s.interpolation);
   s.layout = readEnum(mc, "layout", kMsCacheLayouts, s.layout);
-  if (s.layout == MsCacheLayout::View && s.closure != MsCacheClosure::Camera && mc.find("closure"))
-    ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
   const bool view = s.layout == MsCacheLayout::View;
-  for (const std::string key :
-       {"resolution", "interpolation", "tile", "slices", "filter", "filterTolerance", "filterTwicing", "allocation"})
-    if (mc.find(key) && view != (key == "tile" || key == "slices" || key == "filter" || key == "filterTolerance" ||
-                                 key == "filterTwicing" || key == "allocation"))
-      ctx.warn(mc.keyOf(key), std::string("applies to layout \"") + (view ? "grid" : "view") + "\"; \"" +
-                                  (view ? "view" : "grid") + "\" ignores it");
+  s.closure = readEnum(mc, "closure", kMsCacheClosures, view ? MsCacheClosure::Camera : s.closure);
+  if (view && s.closure != MsCacheClosure::Camera)
+    ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
+  s.interpolation = readEnum(mc, "interpolation", kMsCacheInterpolations, s.interpolation);
   s.resolution = readInt(mc, "resolution", s.resolution, 1, 256);
   s.tile = readInt(mc, "tile", s.tile, 1, 256);
   s.direct = mc.getBool("direct", s.direct);
@@ -105,7 +128,9 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   s.slices = readInt(mc, "slices", s.slices, 2, 64);
   s.filter = readNonNegative(mc, "filter", s.filter);
   if (s.filter > 8) ctx.fail(mc.keyOf("filter"), "must be at most 8 (columns), got " + formatNumber(s.filter));
+  mc.noteRange("filter", "[0, 8]");
   s.filterTolerance = mc.getFloat("filterTolerance", s.filterTolerance);
+  mc.noteRange("filterTolerance", "> 0");
   if (!(s.filterTolerance > 0))
     ctx.fail(mc.keyOf("filterTolerance"), "must be positive, got " + formatNumber(s.filterTolerance));
   s.filterTwicing = mc.getBool("filterTwicing", s.filterTwicing);
@@ -113,6 +138,7 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
     ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
   s.allocation = readEnum(mc, "allocation", kMsCacheAllocations, s.allocation);
   s.guide = readNonNegative(mc, "guide", s.guide);
+  mc.noteRange("guide", "[0, 1)");
   if (!(s.guide < 1))
     ctx.fail(mc.keyOf("guide"), "must be below 1 (the phase function's share covers every direction), got " +
                                     formatNumber(s.guide));
@@ -121,6 +147,10 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
                                 "phase-function directions to guide)");
   s.paths = readInt(mc, "paths", s.paths, 1, 1 << 20);
   s.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.pathsPerLaunch, 1, 1 << 20);
+  for (const char* grid : {"resolution", "interpolation"})
+    if (view) ctx.warnIfChanged(mc.keyOf(grid), "applies to layout \"grid\"; \"view\" ignores it");
+  for (const char* own : {"tile", "slices", "filter", "filterTolerance", "filterTwicing", "allocation"})
+    if (!view) ctx.warnIfChanged(mc.keyOf(own), "applies to layout \"view\"; \"grid\" ignores it");
   mc.reportUnknown();
   return s;
 }
@@ -145,12 +175,13 @@ RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::st
                                   s.octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::None);
   if (s.octaves > 1 && s.multipleScattering != MultipleScattering::Octaves)
     ctx.fail(m.keyOf("octaves"), "applies only with multipleScattering \"octaves\"");
-  if (const json* c = m.find("msCache")) {
-    s.msCache = readMsCache(ctx, *c, m.keyOf("msCache"), s.msCache);
-    if (s.multipleScattering != MultipleScattering::Cache)
-      ctx.warn(m.keyOf("msCache"), std::string("applies to multipleScattering \"cache\"; \"") +
-                                       enumName(kMultipleScattering, s.multipleScattering) + "\" ignores it");
-  }
+  const char* ms = enumName(kMultipleScattering, s.multipleScattering);
+  if (s.multipleScattering != MultipleScattering::Octaves)
+    for (const char* k : {"octaveScattering", "octaveExtinction", "octavePhase"})
+      ctx.warnIfChanged(m.keyOf(k), std::string("applies to multipleScattering \"octaves\"; \"") + ms + "\" ignores it");
+  s.msCache = readMsCache(ctx, section(m, "msCache"), m.keyOf("msCache"), s.msCache);
+  if (s.multipleScattering != MultipleScattering::Cache && ctx.changedUnder(m.keyOf("msCache")))
+    ctx.warn(m.keyOf("msCache"), std::string("applies to multipleScattering \"cache\"; \"") + ms + "\" ignores it");
   m.reportUnknown();
   return s;
 }
@@ -159,28 +190,34 @@ RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::st
 LobeSettings readLobe(JsonContext& ctx, const json& value, const std::string& key, bool emits, LobeSettings s) {
   ObjectReader l(ctx, value, key);
   s.variant = readEnum(l, "variant", kLobeVariants, s.variant);
-  // The corrected estimator has no first-hit search and no fixed depth (lobe.h, C2); the first
-  // hit's step count still marches an emitting medium's light in both variants.
-  if (s.variant == LobeVariant::Corrected)
-    for (const char* k : {"depthFactor", "firstHitSteps"})
-      if (l.find(k) && !(emits && std::string(k) == "firstHitSteps"))
-        ctx.warn(l.keyOf(k), "applies to variant \"eq7\"; \"corrected\" ignores it");
   s.depthFactor = readNonNegative(l, "depthFactor", s.depthFactor);
   s.lobePoints = readInt(l, "lobePoints", s.lobePoints, 1);
   s.lobeRadius = readNonNegative(l, "lobeRadius", s.lobeRadius);
   s.shadowSteps = readInt(l, "shadowSteps", s.shadowSteps, 1);
   s.firstHitSteps = readInt(l, "firstHitSteps", s.firstHitSteps, 1);
+  // The corrected estimator has no first-hit search and no fixed depth (lobe.h, C2); the first
+  // hit's step count still marches an emitting medium's light in both variants.
+  if (s.variant == LobeVariant::Corrected)
+    for (const char* k : {"depthFactor", "firstHitSteps"})
+      if (!(emits && std::string(k) == "firstHitSteps"))
+        ctx.warnIfChanged(l.keyOf(k), "applies to variant \"eq7\"; \"corrected\" ignores it");
+  // Left out, these two take the variant's default (0 here); a resolved scene writes that value.
+  const int viewSteps = lobeViewSteps(s), shadowAreaSamples = lobeShadowAreaSamples(s);
   if (l.find("viewSteps")) s.viewSteps = readInt(l, "viewSteps", 1, 1);
+  l.note("viewSteps", "integer", viewSteps, ">= 1");
   s.minTransmittance = readMinTransmittance(l, s.minTransmittance);
   s.areaLightSamples = readInt(l, "areaLightSamples", s.areaLightSamples, 1, 16);
   s.areaLightPhase = readAreaLightPhase(l, s.areaLightPhase);
   if (l.find("shadowAreaSamples")) s.shadowAreaSamples = readInt(l, "shadowAreaSamples", 1, 1, 16);
+  l.note("shadowAreaSamples", "integer", shadowAreaSamples, "[1, 16]");
   l.reportUnknown();
   return s;
 }
 
 LightCacheSettings readLightCache(JsonContext& ctx, const json& value, const std::string& key, LightCacheSettings s) {
   ObjectReader c(ctx, value, key);
+  c.note("resolution", "integer or string", s.resolution == kLightCacheAuto ? json("auto") : json(s.resolution),
+         "\"auto\", or [0, 1024] (0 = off)");
   if (const json* res = c.find("resolution")) {
     if (res->is_string() && res->get<std::string>() == "auto")
       s.resolution = kLightCacheAuto;
@@ -211,10 +248,12 @@ RendererSettings readRenderer(JsonContext& ctx, const json& value, const std::st
   s.storage = readEnum(r, "storage", kGridStorages, s.storage);
   s.seed = static_cast<uint32_t>(checkIntRange(ctx, r.keyOf("seed"), r.getInteger("seed", s.seed), 0,
                                                std::numeric_limits<uint32_t>::max()));
-  if (const json* v = r.find("pathtrace")) s.pathtrace = readPathtrace(ctx, *v, r.keyOf("pathtrace"), s.pathtrace);
-  if (const json* v = r.find("raymarch")) s.raymarch = readRaymarch(ctx, *v, r.keyOf("raymarch"), s.raymarch);
-  if (const json* v = r.find("lobe")) s.lobe = readLobe(ctx, *v, r.keyOf("lobe"), emits, s.lobe);
-  if (const json* v = r.find("lightCache")) s.lightCache = readLightCache(ctx, *v, r.keyOf("lightCache"), s.lightCache);
+  r.noteRange("seed", "[0, " + std::to_string(std::numeric_limits<uint32_t>::max()) + "]");
+  s.pathtrace = readPathtrace(ctx, section(r, "pathtrace"), r.keyOf("pathtrace"), s.pathtrace);
+  s.raymarch = readRaymarch(ctx, section(r, "raymarch"), r.keyOf("raymarch"), s.raymarch);
+  s.lobe = readLobe(ctx, section(r, "lobe"), r.keyOf("lobe"), emits, s.lobe);
+  s.lightCache = readLightCache(ctx, section(r, "lightCache"), r.keyOf("lightCache"), s.lightCache);
+  warnSectionsThatDoNotApply(ctx, r, s);
   r.reportUnknown();
   return s;
 }
@@ -237,5 +276,20 @@ bool isRealtime(Algorithm a) {
 }
 
 bool algorithmFromName(const std::string& name, Algorithm* out) { return enumFromName(kAlgorithms, name, out); }
+
+namespace {
+// A lobe key the scene left out (0) takes its variant's default; eq7's are the dissertation's.
+int lobeDefault(const LobeSettings& l, int value, int eq7, int corrected) {
+  if (value > 0) return value;
+  switch (l.variant) {
+    case LobeVariant::Eq7: return eq7;
+    case LobeVariant::Corrected: return corrected;
+  }
+  throw std::logic_error("lobeDefault: not a LobeVariant");
+}
+}  // namespace
+
+int lobeViewSteps(const LobeSettings& l) { return lobeDefault(l, l.viewSteps, 24, 16); }
+int lobeShadowAreaSamples(const LobeSettings& l) { return lobeDefault(l, l.shadowAreaSamples, 1, 4); }
 
 }  // namespace narval

@@ -202,6 +202,9 @@ struct LobeSettings {
   AreaLightPhase areaLightPhase = AreaLightPhase::Points;  // as the ray marcher's
   int shadowAreaSamples = 0;       // as the ray marcher's; 0 = the variant's: eq7 1, corrected 4
 };
+// What the lobe kernels take for the two keys whose default is the variant's.
+int lobeViewSteps(const LobeSettings& l);
+int lobeShadowAreaSamples(const LobeSettings& l);
 
 // The light-transmittance cache of the real-time kernels (kernels/shared/light_cache.h).
 constexpr int kLightCacheAuto = -1;
@@ -234,17 +237,26 @@ struct Scene {
   Vec3f background{0, 0, 0};
   std::vector<std::string> warnings;  // unknown keys and other non-fatal findings
   std::vector<std::string> overrides;  // the --set PATH=VALUE strings applied, in order
-  nlohmann::json document;             // the JSON as rendered: the file with the overrides applied
+  // The scene as rendered: the file with the overrides applied and every default the loader took
+  // written out (`narval scene --resolved`); it reads back to the same settings.
+  nlohmann::json document;
 };
 
 // Loads and validates a scene. `overrides` are "dotted.path=value" strings (--set) applied to the
 // JSON before validation. Throws InputError ("FILE: KEY: what is wrong") on any bad input.
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
-// The same from JSON text in memory; `path` names it in messages and anchors relative paths. `keysAsked`, if
-// given, gets every key the loader looked up (present or not) as the scene-format reference names it
-// ("materials[].g"): the schema, for the documentation check.
+// The same from JSON text in memory; `path` names it in messages and anchors relative paths.
 Scene parseScene(const std::string& jsonText, const std::string& path,
-                 const std::vector<std::string>& overrides = {}, std::set<std::string>* keysAsked = nullptr);
+                 const std::vector<std::string>& overrides = {});
+
+// One key of the scene format as the loader reads it ("materials[].g": indices dropped), learnt by
+// reading scenes that between them take every branch of the loader (scene_keys.cpp).
+struct SceneKey {
+  std::string key, type, range;
+  std::vector<nlohmann::json> defaults;  // the distinct defaults taken (more than one: it depends on another key)
+  bool required = false;
+};
+std::vector<SceneKey> sceneKeyTable();
 
 // "auto", "image", "buffer" or "bricks": the scene file's spelling.
 const char* gridStorageName(GridStorage s);

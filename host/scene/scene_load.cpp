@@ -102,11 +102,12 @@ void readPhaseParameter(ObjectReader& r, Material& m) {
     if (!k.key) continue;
     if (k.id == m.phase) m.phaseParameter = k.fallback;
     const json* v = r.find(k.key);
+    const std::string range = "[" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "]";
+    r.note(k.key, "number", k.id == m.phase ? jsonNumber(k.fallback) : json(), range);
     if (!v) continue;
     const std::string key = r.keyOf(k.key);
     const float x = toFloat(r.context(), *v, key);
-    if (!(x >= k.lo && x <= k.hi))
-      r.context().fail(key, "must be in [" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "], got " + formatNumber(x));
+    if (!(x >= k.lo && x <= k.hi)) r.context().fail(key, "must be in " + range + ", got " + formatNumber(x));
     if (k.id != m.phase) {
       if (x != k.fallback)
         r.context().warn(key, std::string("ignored by the ") + ownName + " phase function (use \"phaseFunction\": \"" +
@@ -127,6 +128,8 @@ Emission readEmission(JsonContext& ctx, const json& value, const std::string& ke
   Emission e;
   const json* grid = r.find("grid");
   const json* temperature = r.find("temperature");
+  r.note("grid", "string", nullptr);
+  r.note("temperature", "number or string", nullptr, ">= 0 (kelvin), or a grid's name");
   if (grid && temperature)
     ctx.fail(r.keyOf("temperature"), "give either \"grid\" (Le = color · scale · grid) or \"temperature\" "
                                      "(blackbody), not both");
@@ -154,6 +157,7 @@ Emission readEmission(JsonContext& ctx, const json& value, const std::string& ke
     if (grid) e.grid = gridName(*grid, "grid");
     e.color = r.getVec3("color", e.color);
     checkNonNegative(ctx, r.keyOf("color"), e.color);
+    r.noteRange("color", ">= 0");
     for (const char* k : {"temperatureOffset", "temperatureScale"})
       if (r.has(k)) ctx.fail(r.keyOf(k), "applies to blackbody emission only (give \"temperature\")");
   }
@@ -171,15 +175,21 @@ Material readMaterial(JsonContext& ctx, const json& value, const std::string& ke
   if (m.type == MaterialType::Emitter) {
     m.albedo = r.requireVec3("albedo");
     checkNonNegative(ctx, r.keyOf("albedo"), m.albedo);
+    r.noteRange("albedo", ">= 0");
   } else {
     m.scattering = r.requireVec3("scattering");
     checkNonNegative(ctx, r.keyOf("scattering"), m.scattering);
+    r.noteRange("scattering", ">= 0");
     m.absorption = r.requireVec3("absorption");
     checkNonNegative(ctx, r.keyOf("absorption"), m.absorption);
+    r.noteRange("absorption", ">= 0");
     m.phase = readEnum(r, "phaseFunction", kPhaseFunctions, m.phase);
     readPhaseParameter(r, m);
-    if (const json* path = r.find("path"))
-      m.path = resolveVolumePath(toString(ctx, *path, r.keyOf("path")), ctx.file, r.keyOf("path"));
+    r.note("path", "string", nullptr);
+    if (const json* path = r.find("path")) {
+      m.path = toString(ctx, *path, r.keyOf("path"));
+      if (ctx.checkFiles) m.path = resolveVolumePath(m.path, ctx.file, r.keyOf("path"));
+    }
     m.density = readNonNegative(r, "density", m.density);
     m.gridName = r.getString("grid", m.gridName);
     if (m.gridName.empty()) ctx.fail(r.keyOf("grid"), "must not be empty");
@@ -187,7 +197,8 @@ Material readMaterial(JsonContext& ctx, const json& value, const std::string& ke
     // A homogeneous medium (no "path") has no grid to name or place: say so rather than ignore it.
     if (m.path.empty())
       for (const char* k : {"grid", "gridSpace"})
-        if (r.has(k)) ctx.warn(r.keyOf(k), "ignored: the medium is homogeneous (no \"path\")");
+        ctx.warnIfChanged(r.keyOf(k), "ignored: the medium is homogeneous (no \"path\")");
+    r.note("emission", "object", nullptr);
     if (const json* e = r.find("emission")) m.emission = readEmission(ctx, *e, r.keyOf("emission"), !m.path.empty());
   }
   r.reportUnknown();
@@ -226,6 +237,7 @@ void readLightKeys(ObjectReader& r, Primitive& p) {
     }
     if (k.key) {
       p.lightParameter = r.getFloat(k.key, k.fallback);
+      r.noteRange(k.key, "[" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "]");
       if (!(p.lightParameter >= k.lo && p.lightParameter <= k.hi))
         r.context().fail(r.keyOf(k.key), "must be in [" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "], got " +
                                              formatNumber(p.lightParameter));
@@ -240,11 +252,13 @@ Primitive readPrimitive(JsonContext& ctx, const json& value, const std::string& 
   const int type = requireEnum(r, "type", kPrimitiveTypes);
   p.type = type == kVolumeType ? PrimitiveType::Volume : PrimitiveType::Light;
   p.lightKind = type == kVolumeType ? -1 : type;
-  if (const json* t = r.find("transform")) {
-    if (p.type == PrimitiveType::Light && lightKindKeys(p.lightKind).scaled < 0)
-      ctx.warn(r.keyOf("transform"), std::string("ignored by a ") + primitiveTypeName(p) + " light");
-    else
-      p.transform = readTransform(ctx, *t, r.keyOf("transform"), p);
+  const json* t = r.find("transform");
+  r.note("transform", "object", nullptr);
+  if (p.type == PrimitiveType::Light && lightKindKeys(p.lightKind).scaled < 0) {
+    if (t) ctx.warn(r.keyOf("transform"), std::string("ignored by a ") + primitiveTypeName(p) + " light");
+  } else {
+    static const json kIdentity = json::object();  // left out: every key its default
+    p.transform = readTransform(ctx, t ? *t : kIdentity, r.keyOf("transform"), p);
   }
   readLightKeys(r, p);
   p.materialName = r.requireString("materialName");
@@ -265,10 +279,12 @@ Camera readCamera(JsonContext& ctx, const json& value, const std::string& key) {
   c.lookAt = r.requireVec3("lookAt");
   c.up = r.getVec3("up", c.up);
   c.vfov = r.getFloat("vfov", c.vfov);
+  r.noteRange("vfov", "(0, 180) degrees");
   if (!(c.vfov > 0 && c.vfov < 180))
     ctx.fail(r.keyOf("vfov"), "must be in (0, 180) degrees, got " + formatNumber(c.vfov));
   c.aperture = readNonNegative(r, "aperture", c.aperture);
   c.focus = r.getFloat("focus", c.focus);
+  r.noteRange("focus", "> 0");
   if (!(c.focus > 0)) ctx.fail(r.keyOf("focus"), "must be positive, got " + formatNumber(c.focus));
   c.speed = readNonNegative(r, "speed", c.speed);
   // The camera basis is built from these: a degenerate one would render NaNs.
@@ -282,6 +298,7 @@ Camera readCamera(JsonContext& ctx, const json& value, const std::string& key) {
 
 void readMaterials(JsonContext& ctx, ObjectReader& root, Scene& scene) {
   const json& list = toArray(ctx, root.require("materials"), "materials");
+  root.note("materials", "array of objects", nullptr);
   std::map<std::string, size_t> byName;
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string key = indexKey("materials", i);
@@ -314,6 +331,7 @@ void linkMaterial(const JsonContext& ctx, const Scene& scene, Primitive& p, cons
 
 void readPrimitives(JsonContext& ctx, ObjectReader& root, Scene& scene) {
   const json& list = toArray(ctx, root.require("primitives"), "primitives");
+  root.note("primitives", "array of objects", nullptr);
   int volumes = 0;
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string key = indexKey("primitives", i);
@@ -378,6 +396,27 @@ class DuplicateKeys {
   std::vector<Frame> frames_;
 };
 
+// The scene as narval renders it: `doc` with every key the loader took a default for written out,
+// so that it reads back to the same settings with nothing left to a default.
+json resolvedDocument(const json& doc, const std::map<std::string, KeyRecord>& keys) {
+  json out = doc;
+  for (const auto& [key, record] : keys) {
+    if (record.given || record.fallback.is_null()) continue;
+    std::string pointer = "/";  // "materials[1].g" -> "/materials/1/g"
+    for (char c : key) {
+      switch (c) {
+        case '.': case '[': pointer += '/'; break;
+        case ']': break;
+        case '~': pointer += "~0"; break;
+        case '/': pointer += "~1"; break;
+        default: pointer += c;
+      }
+    }
+    out[json::json_pointer(pointer)] = record.fallback;
+  }
+  return out;
+}
+
 std::string parseMessage(const json::exception& e) {
   // Drop nlohmann's "[json.exception.parse_error.101] " tag; keep its line/column text.
   const std::string what = e.what();
@@ -387,12 +426,14 @@ std::string parseMessage(const json::exception& e) {
 
 }  // namespace
 
-Scene parseScene(const std::string& jsonText, const std::string& path, const std::vector<std::string>& overrides,
-                 std::set<std::string>* keysAsked) {
+namespace scene_detail {
+
+Scene parseScene(JsonContext& ctx, const std::string& jsonText, const std::vector<std::string>& overrides) {
   Scene scene;
-  scene.sourcePath = path;
+  scene.sourcePath = ctx.file;
   scene.overrides = overrides;
-  JsonContext ctx{path, &scene.warnings, {}, keysAsked, {}};
+  ctx.warnings = &scene.warnings;
+  const std::string& path = ctx.file;
 
   json doc;
   try {
@@ -413,18 +454,21 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
   std::vector<std::pair<std::string, std::string>> overridden;  // (as written, loader key)
   for (const std::string& spec : overrides)
     overridden.emplace_back(spec.substr(0, spec.find('=')), applyOverride(doc, spec, path));
-  scene.document = doc;
 
   ObjectReader root(ctx, doc, "");
   readMaterials(ctx, root, scene);
   readPrimitives(ctx, root, scene);
   scene.camera = readCamera(ctx, root.require("camera"), "camera");
+  root.note("camera", "object", nullptr);
+  root.note("renderer", "object", nullptr);
   bool emits = false;
   for (const Material& m : scene.materials) emits = emits || m.emission.kind != EmissionKind::None;
   scene.renderer = readRenderer(ctx, root.require("renderer"), "renderer", emits);
   scene.background = root.getVec3("background", scene.background);
   checkNonNegative(ctx, "background", scene.background);
+  root.noteRange("background", ">= 0");
   root.reportUnknown();
+  scene.document = resolvedDocument(doc, ctx.keys);
 
   // In a file an unknown key is a warning; on the command line it is a typo the user is waiting on.
   for (const auto& [written, key] : overridden)
@@ -441,6 +485,13 @@ Scene parseScene(const std::string& jsonText, const std::string& path, const std
 
   warnIfDark(ctx, scene);
   return scene;
+}
+
+}  // namespace scene_detail
+
+Scene parseScene(const std::string& jsonText, const std::string& path, const std::vector<std::string>& overrides) {
+  JsonContext ctx{path, nullptr, {}, {}, true, {}};
+  return parseScene(ctx, jsonText, overrides);
 }
 
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {

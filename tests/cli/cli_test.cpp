@@ -133,6 +133,41 @@ TEST_F(Cli, UnknownAlgorithmAndBadOptions) {
   EXPECT_EQ(outputs({"scene.json", "cloud.vdb"}), std::vector<std::string>{});
 }
 
+// narval scene --resolved prints the scene with its defaults written out (--set applied), which
+// renders as the scene does; --keys prints the loader's key table; misuse is one line, exit 2.
+TEST_F(Cli, SceneResolvedAndKeys) {
+  writeVdb((dir_ / "cloud.vdb").string(), makeCloud(8, 1));
+  write("scene.json", listing41Json("cloud.vdb"));
+  const RunResult r = run("scene scene.json --set renderer.spp=7 --resolved");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const nlohmann::json doc = nlohmann::json::parse(r.out);
+  EXPECT_EQ(doc["renderer"]["spp"], 7);
+  EXPECT_EQ(doc["renderer"]["raymarch"]["steps"], 60);
+  write("resolved.json", r.out);
+  EXPECT_EQ(run("scene resolved.json --resolved").out, r.out);
+
+  const RunResult keys = run("scene --keys");
+  ASSERT_EQ(keys.code, 0) << keys.err;
+  bool found = false;
+  for (const auto& k : nlohmann::json::parse(keys.out))
+    if (k["key"] == "renderer.bounces") {
+      found = true;
+      EXPECT_EQ(k["defaults"], nlohmann::json::array({3}));
+      EXPECT_EQ(k["type"], "integer");
+    }
+  EXPECT_TRUE(found);
+
+  expectBadInput(*this, run("scene scene.json"), "narval: narval scene: give --resolved (with a SCENE.json) or --keys");
+  expectBadInput(*this, run("scene --resolved"), "narval: --resolved: needs a SCENE.json");
+  expectBadInput(*this, run("scene scene.json --keys"),
+                 "narval: --keys: takes no scene, --set or --resolved (it lists the format's keys)");
+  expectBadInput(*this, run("scene scene.json --resolved --set renderer.sp=3"),
+                 "narval: scene.json: --set renderer.sp: not a scene setting (unknown key renderer.sp; did you mean "
+                 "renderer.spp?)");
+  EXPECT_EQ(outputs({"scene.json", "cloud.vdb", "resolved.json"}), std::vector<std::string>{});
+}
+
 TEST_F(Cli, DevicesJsonListsAtLeastOneDevice) {
   const RunResult r = run("devices --json");
   ASSERT_EQ(r.code, 0) << r.err;

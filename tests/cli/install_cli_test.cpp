@@ -22,7 +22,8 @@ TEST_F(InstallCli, TheInstalledBinaryRendersFromItsPrefix) {
   ASSERT_EQ(install.code, 0) << install.out << install.err;
   const fs::path binary = prefix / "bin" / "narval";
   ASSERT_TRUE(fs::exists(binary));
-  EXPECT_TRUE(fs::exists(prefix / "share" / "doc" / "narval" / "scene-format.md"));
+  for (const char* page : {"scene-format.md", "cli.md", "realtime.md", "images/cloud_sun.png"})  // the README's links
+    EXPECT_TRUE(fs::exists(prefix / "share" / "doc" / "narval" / "docs" / page)) << page;
   EXPECT_TRUE(fs::exists(prefix / "share" / "doc" / "narval" / "README.md"));
 
   const test::RunResult version = runCommand("'" + binary.string() + "' --version");

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
+#include "render/render_exr.h"
 #include "scene/scene.h"
 #include "test_support.h"
 
@@ -200,8 +201,9 @@ TEST(SceneDefaults, ExtensionsAreRead) {
       "lobe": {"depthFactor": 0, "lobePoints": 5, "lobeRadius": 0.25, "shadowSteps": 9}})"));
   j["background"] = {0.05, 0.07, 0.1};
   const Scene s = parseScene(j.dump(), "s.json");
-  // Read all the same; the medium has no "path", which the two grid keys are told about.
-  EXPECT_EQ(s.warnings.size(), 2u);
+  // Read all the same; the medium has no "path", which the two grid keys are told about, and the
+  // ray marcher's keys are said to be ignored by the Lobe Estimator.
+  EXPECT_EQ(s.warnings.size(), 3u);
   EXPECT_EQ(s.materials[1].phase, PHASE_HG);
   EXPECT_EQ(s.materials[1].phaseParameter, -0.3f);
   EXPECT_EQ(s.materials[1].gridName, "smoke");
@@ -441,6 +443,7 @@ TEST(SceneErrors, NearMissKeysNameTheKeyTheyProbablyMeant) {
 // The multiple-scattering cache's settings without the cache are said to be ignored.
 TEST(SceneWarnings, MsCacheSettingsWithoutTheCache) {
   json j = minimalScene();
+  j["renderer"]["algorithm"] = "raymarch";
   j["renderer"]["raymarch"] = {{"msCache", {{"paths", 64}}}};
   EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
             (std::vector<std::string>{"s.json: renderer.raymarch.msCache: applies to multipleScattering \"cache\"; "
@@ -558,6 +561,7 @@ TEST(SceneWarnings, NoLightAndBlackBackground) {
 // ignored under it, and not under eq7 (where they count).
 TEST(SceneWarnings, EqSevenKeysUnderTheCorrectedLobe) {
   json j = minimalScene();
+  j["renderer"]["algorithm"] = "lobe";
   j["renderer"]["lobe"] = {{"variant", "corrected"}, {"depthFactor", 5}, {"firstHitSteps", 30}, {"lobeRadius", 2}};
   EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
             (std::vector<std::string>{
@@ -571,6 +575,87 @@ TEST(SceneWarnings, EqSevenKeysUnderTheCorrectedLobe) {
                 "s.json: renderer.lobe.depthFactor: applies to variant \"eq7\"; \"corrected\" ignores it"}));
   j["renderer"]["lobe"]["variant"] = "eq7";
   EXPECT_TRUE(parseScene(j.dump(), "s.json").warnings.empty());
+}
+
+// A section set away from its defaults for an algorithm that does not read it is named; a section
+// at its defaults (as a resolved scene writes every one) is not.
+TEST(SceneWarnings, SectionsTheAlgorithmDoesNotRead) {
+  json j = minimalScene();  // the path tracer
+  j["renderer"]["raymarch"] = {{"steps", 30}};
+  j["renderer"]["lobe"] = {{"lobePoints", 30}};  // its default
+  j["renderer"]["lightCache"] = {{"resolution", 32}};
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
+            (std::vector<std::string>{
+                "s.json: renderer.raymarch: applies to algorithm \"raymarch\"; algorithm \"pathtrace\" ignores it",
+                "s.json: renderer.lightCache: applies to the real-time algorithms; algorithm \"pathtrace\" ignores it"}));
+  j["renderer"]["algorithm"] = "lobe";
+  j["renderer"]["pathtrace"] = {{"shadowRoulette", 0.1}};
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
+            (std::vector<std::string>{
+                "s.json: renderer.pathtrace: applies to the path tracer and the ray marcher's multiple-scattering "
+                "cache; algorithm \"lobe\" ignores it",
+                "s.json: renderer.raymarch: applies to algorithm \"raymarch\"; algorithm \"lobe\" ignores it"}));
+  // The ray marcher's cache traces paths with the path tracer's settings; the octaves' keys apply
+  // only to the octaves.
+  j["renderer"]["algorithm"] = "raymarch";
+  j["renderer"]["raymarch"] = {{"multipleScattering", "cache"}, {"octavePhase", 0.7}};
+  EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
+            (std::vector<std::string>{"s.json: renderer.raymarch.octavePhase: applies to multipleScattering "
+                                      "\"octaves\"; \"cache\" ignores it"}));
+}
+
+// ---------------------------------------------------------------- the resolved scene
+
+// Scene::document writes out every default the loader took (narval scene --resolved): it names
+// the values used, reads back to the same document without a warning, and so keys a render the
+// same way; a key given at its default changes nothing.
+TEST(SceneResolved, ReadsBackToTheSameDocumentAndRenderKey) {
+  json j = minimalScene();
+  j["renderer"]["algorithm"] = "lobe";
+  j["renderer"]["lobe"] = {{"variant", "corrected"}};
+  const Scene s = parseScene(j.dump(), "s.json");
+  const json& r = s.document;
+  EXPECT_EQ(r["renderer"]["spp"], 1000);
+  EXPECT_EQ(r["renderer"]["lobe"]["viewSteps"], 16);  // the corrected variant's default
+  EXPECT_EQ(r["renderer"]["lobe"]["shadowAreaSamples"], 4);
+  EXPECT_EQ(r["renderer"]["raymarch"]["msCache"]["paths"], 256);
+  EXPECT_EQ(r["renderer"]["lightCache"]["resolution"], "auto");
+  EXPECT_EQ(r["renderer"]["toneMapping"], "aces");
+  EXPECT_EQ(r["renderer"]["pathtrace"]["shadowRoulette"], 0.05);  // the float's shortest decimal
+  EXPECT_EQ(r["materials"][1]["phaseFunction"], "isotropic");
+  EXPECT_FALSE(r["materials"][1].contains("g"));  // another phase function's key is not written
+  EXPECT_EQ(r["primitives"][1]["transform"]["scale"], json({1, 1, 1}));
+  EXPECT_EQ(r["camera"]["vfov"], 45);
+  EXPECT_EQ(r["background"], json({0, 0, 0}));
+
+  const Scene again = parseScene(r.dump(), "s.json");
+  EXPECT_TRUE(again.warnings.empty()) << again.warnings.front();
+  EXPECT_EQ(again.document, r);
+  EXPECT_EQ(renderKey(again), renderKey(s));
+  EXPECT_EQ(lobeViewSteps(again.renderer.lobe), lobeViewSteps(s.renderer.lobe));
+
+  EXPECT_EQ(renderKey(parseScene(j.dump(), "s.json", {"renderer.bounces=3"})), renderKey(s));
+  EXPECT_NE(renderKey(parseScene(j.dump(), "s.json", {"renderer.bounces=4"})), renderKey(s));
+}
+
+// The loader's key table (narval scene --keys): every key typed; defaults that depend on another
+// key listed as each one.
+TEST(SceneKeyTable, EveryKeyTypedWithItsDefaultsAndRange) {
+  const std::vector<SceneKey> table = sceneKeyTable();
+  auto find = [&](const std::string& key) -> const SceneKey& {
+    for (const SceneKey& k : table)
+      if (k.key == key) return k;
+    throw std::runtime_error("no key " + key);
+  };
+  for (const SceneKey& k : table) EXPECT_FALSE(k.type.empty()) << k.key;
+  EXPECT_EQ(find("renderer.spp").defaults, std::vector<json>{1000});
+  EXPECT_EQ(find("renderer.spp").range, ">= 1");
+  EXPECT_EQ(find("renderer.lobe.viewSteps").defaults, (std::vector<json>{24, 16}));
+  EXPECT_EQ(find("materials[].g").range, "[-1, 1]");
+  EXPECT_EQ(find("materials[].phaseFunction").range, "isotropic, hg, mie");
+  EXPECT_TRUE(find("camera.position").required);
+  EXPECT_TRUE(find("primitives[].direction").required);  // the distant light's
+  EXPECT_FALSE(find("renderer.seed").required);
 }
 
 // ---------------------------------------------------------------- --set overrides
