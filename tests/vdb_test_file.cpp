@@ -66,6 +66,8 @@ void writeVdbTestFile(const std::string& path, const std::string& kind) {
     openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
     f->setName("density");
     grids.push_back(f);
+  } else if (kind == "no grids") {
+    // A valid file holding no grid at all.
   } else if (kind == "invalid") {
     openvdb::FloatGrid::Ptr f = openvdb::FloatGrid::create(0.0f);
     f->tree().setValue(openvdb::Coord(0, 0, 0), 1.0f);

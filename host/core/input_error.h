@@ -28,4 +28,20 @@ inline InputError inputError(const std::string& file, const std::string& key, co
   return InputError(out);
 }
 
+// A library's own message (OpenVDB's, OpenEXR's) quoted inside one of ours: one line of printable
+// ASCII, blanks collapsed, at most 160 characters. A corrupt file's bytes can reach such messages
+// (OpenVDB's "Map is not registered" names the map type it read).
+inline std::string oneLine(const std::string& what) {
+  std::string out;
+  for (const char c : what) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    const bool printable = u > 0x20 && u < 0x7f;
+    if (printable) out += c;
+    else if (!out.empty() && out.back() != ' ') out += ' ';
+    if (out.size() >= 160) return out + "...";
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
 }  // namespace narval

@@ -64,12 +64,6 @@ class FileOStream : public Imf::OStream {
   std::string error_;
 };
 
-std::string oneLine(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  return s;
-}
-
 // Opens an EXR for reading; every failure is an InputError "PATH: what".
 std::unique_ptr<Imf::InputFile> openExr(const std::string& path) {
   std::error_code ec;

@@ -43,7 +43,7 @@ bool runInChild(const std::string& path, const std::string& cannot, const std::f
       out.ok = 1;
     } catch (const std::exception& e) {
       out.ok = dynamic_cast<const InputError*>(&e) ? 0 : -1;
-      std::snprintf(out.message, sizeof(out.message), "%s", oneLine(e.what()).c_str());
+      std::snprintf(out.message, sizeof(out.message), "%s", out.ok == 0 ? e.what() : oneLine(e.what()).c_str());
     }
     // The record goes last: a child that dies before this leaves no magic behind.
     if (::pwrite(mem.fd, &out, sizeof(out), 0) != ssize_t(sizeof(out))) ::_exit(3);

@@ -50,13 +50,6 @@ void initOpenVdb() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
-std::string oneLine(const char* what) {
-  std::string s(what);
-  for (char& c : s) {
-    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
-  }
-  return s;
-}
 
 namespace {
 
@@ -83,31 +76,35 @@ struct GridEntry {
   bool isFloat = false;
 };
 
-// Opens `path` (no delayed loading, so no memory map) and lists its grids from their metadata
-// (names, types, transforms: no tree data is read).
-std::vector<GridEntry> listGrids(openvdb::io::File& file, const std::string& path) {
-  std::vector<GridEntry> out;
+// Every grid in the file, read through our own stream with exceptions on: OpenVDB does not check
+// for short reads, so io::File hands back a truncated file's grid silently filled with garbage or
+// zeros, takes a file cut inside its header for one with no grids, and reads a cut grid's
+// descriptor as a length of gigabytes; here any read past the end throws. io::Stream reads every
+// grid in the file (all small next to the dense copy). InputError when the file cannot be read.
+openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
   try {
-    file.open(/*delayLoad=*/false);
-    openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
-    for (const openvdb::GridBase::Ptr& g : *grids) {
-      out.push_back({g->getName(), g->valueType(), g->isType<openvdb::FloatGrid>()});
-    }
+    std::ifstream in(path, std::ios::binary);
+    in.exceptions(std::ios::failbit | std::ios::badbit);
+    openvdb::io::Stream stream(in, /*delayLoad=*/false);
+    return stream.getGrids();
+  } catch (const std::ios_base::failure&) {
+    throw inputError(path, "", kUnreadable + " (a read ran past its end)");
   } catch (const std::exception& e) {
     throw inputError(path, "", kUnreadable + " (OpenVDB: " + oneLine(e.what()) + ")");
   }
+}
+
+// The grids' names and types, in the file's order.
+std::vector<GridEntry> listGrids(const openvdb::GridPtrVec& grids) {
+  std::vector<GridEntry> out;
+  for (const openvdb::GridBase::Ptr& g : grids) out.push_back({g->getName(), g->valueType(), g->isType<openvdb::FloatGrid>()});
   return out;
 }
 
-// Every grid in the file, read through our own stream with exceptions on: OpenVDB does not check
-// for short reads, so io::File hands back a truncated file's grid silently filled with garbage or
-// zeros; here any read past the end throws std::ios_base::failure. io::Stream reads every grid in
-// the file (all small next to the dense copy).
-openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  in.exceptions(std::ios::failbit | std::ios::badbit);
-  openvdb::io::Stream stream(in, /*delayLoad=*/false);
-  return stream.getGrids();
+// Names listed in messages: sorted, so that a message does not depend on the writer's order.
+std::vector<GridEntry> sortedByName(std::vector<GridEntry> grids) {
+  std::sort(grids.begin(), grids.end(), [](const GridEntry& a, const GridEntry& b) { return a.name < b.name; });
+  return grids;
 }
 
 std::string describeGrids(const std::vector<GridEntry>& grids) {
@@ -126,41 +123,21 @@ std::string dimsString(int64_t x, int64_t y, int64_t z) {
   return std::to_string(x) + "x" + std::to_string(y) + "x" + std::to_string(z);
 }
 
-// The grid named `gridName` must exist and hold floats: one line naming what the file has.
-void requireFloatGrid(const std::string& path, const std::string& gridName) {
-  openvdb::io::File file(path);
-  const std::vector<GridEntry> grids = listGrids(file, path);
+// The grid named `gridName` of `all`, which must exist and hold floats: one line naming what the
+// file has otherwise.
+openvdb::FloatGrid::Ptr requireFloatGrid(const std::string& path, const std::string& gridName,
+                                         const openvdb::GridPtrVec& all) {
+  const std::vector<GridEntry> grids = listGrids(all);
   const auto entry = std::find_if(grids.begin(), grids.end(), [&](const GridEntry& g) { return g.name == gridName; });
   if (entry == grids.end())
-    throw inputError(path, "grid", "no grid named " + quoted(gridName) + " (" + describeGrids(grids) + ")");
-  if (entry->isFloat) return;
+    throw inputError(path, "grid", "no grid named " + quoted(gridName) + " (" + describeGrids(sortedByName(grids)) + ")");
+  if (entry->isFloat) return openvdb::gridPtrCast<openvdb::FloatGrid>(all[size_t(entry - grids.begin())]);
   std::string floats;
-  for (const GridEntry& g : grids)
+  for (const GridEntry& g : sortedByName(grids))
     if (g.isFloat) floats += (floats.empty() ? "" : ", ") + g.name;
   throw inputError(path, "grid",
                    quoted(gridName) + " is a " + entry->valueType + " grid; narval needs a float grid (" +
                        (floats.empty() ? std::string("the file has none") : "float grids in the file: " + floats) + ")");
-}
-
-openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string& gridName) {
-  openvdb::FloatGrid::Ptr grid;
-  try {
-    const openvdb::GridPtrVecPtr all = readAllGrids(path);  // keep it alive through the loop
-    for (const openvdb::GridBase::Ptr& g : *all) {
-      if (g->getName() == gridName) {
-        grid = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-        break;
-      }
-    }
-  } catch (const std::ios_base::failure&) {
-    throw inputError(path, "grid", "cannot read " + quoted(gridName) +
-                                       " (the file is truncated or corrupt: a read ran past its end)");
-  } catch (const std::exception& e) {
-    throw inputError(path, "grid", "cannot read " + quoted(gridName) + " (the file is truncated or corrupt: " +
-                                       oneLine(e.what()) + ")");
-  }
-  if (!grid) throw inputError(path, "grid", "cannot read " + quoted(gridName) + " as a float grid");
-  return grid;
 }
 
 // Dims are ints, an x-y slice's voxel count too (grid_trilinear's stride), and the whole grid at
@@ -204,8 +181,8 @@ void setIndexToWorld(Decoded& out, const openvdb::Mat4d& m, const openvdb::Coord
 // box, the size limit and the dense copy. Throws InputError (the full one-line message).
 template <typename Allocate>
 Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate&& allocate, bool serial) {
-  requireFloatGrid(path, gridName);
-  const openvdb::FloatGrid::Ptr grid = readFloatGrid(path, gridName);
+  const openvdb::GridPtrVecPtr all = readAllGrids(path);  // keeps the grid alive
+  const openvdb::FloatGrid::Ptr grid = requireFloatGrid(path, gridName, *all);
   // Transform: affine only (a frustum map is not linear).
   const openvdb::math::MapBase::ConstPtr map = grid->transform().baseMap();
   if (!map->isLinear()) {
@@ -232,9 +209,8 @@ Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate
 }
 
 std::vector<std::string> floatGridNames(const std::string& path) {
-  openvdb::io::File file(path);
   std::vector<std::string> names;
-  for (const GridEntry& g : listGrids(file, path)) {
+  for (const GridEntry& g : sortedByName(listGrids(*readAllGrids(path)))) {
     if (g.isFloat) names.push_back(g.name);
   }
   return names;
@@ -243,14 +219,7 @@ std::vector<std::string> floatGridNames(const std::string& path) {
 // Every grid of the file read whole and described (grid_info.h). Throws InputError.
 std::vector<GridInfo> describeVdbGrids(const std::string& path) {
   std::vector<GridInfo> out;
-  openvdb::GridPtrVecPtr grids;
-  try {
-    grids = readAllGrids(path);
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw inputError(path, "", kUnreadable + " (OpenVDB: " + oneLine(e.what()) + ")");
-  }
+  const openvdb::GridPtrVecPtr grids = readAllGrids(path);
   for (const openvdb::GridBase::Ptr& g : *grids) {
     GridInfo info;
     info.name = g->getName();

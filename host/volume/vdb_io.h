@@ -11,8 +11,6 @@ namespace narval {
 
 // openvdb::initialize(), once per process.
 void initOpenVdb();
-// An exception's text made fit for a one-line message (OpenVDB's can span lines).
-std::string oneLine(const char* what);
 
 // A grid as decoded (vdb_io.cpp, decodeVdb): its size and index-to-world map; the dense values go
 // where the caller asked.

@@ -273,8 +273,8 @@ TEST(VdbErrors, MissingAndNonVdbFiles) {
   EXPECT_EQ(msg.rfind(text + unreadable, 0), 0u) << msg;
   const std::string empty = dir.file("empty.vdb");
   writeFile(empty, "");
-  const std::string msg2 = inputErrorOf([&] { narval::loadVdb(empty, "density"); });
-  EXPECT_EQ(msg2.rfind(empty + unreadable, 0), 0u) << msg2;
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(empty, "density"); }),
+            empty + ": not a readable OpenVDB file: truncated, corrupt or of another format (a read ran past its end)");
   // A real file cut short inside its grid says so.
   const std::string whole = dir.file("whole.vdb"), cut = dir.file("cut.vdb");
   narval::writeVdb(whole, paddedGrid(4, 4, 4, 1, 1, 1));
@@ -282,7 +282,7 @@ TEST(VdbErrors, MissingAndNonVdbFiles) {
   for (size_t n : {bytes.size() / 2, bytes.size() - 10}) {
     writeFile(cut, bytes.substr(0, n));
     EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(cut, "density"); }),
-              cut + ": grid: cannot read 'density' (the file is truncated or corrupt: a read ran past its end)")
+              cut + ": not a readable OpenVDB file: truncated, corrupt or of another format (a read ran past its end)")
         << n << " bytes";
   }
 }
@@ -316,6 +316,28 @@ TEST(VdbErrors, FrustumEmptyAndOversizedGrids) {
   EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(huge, "density"); }),
             huge + ": grid: 'density' active bounding box 2048x2048x2048 = 8589934592 voxels needs 32768 MiB as "
                    "dense floats, over the 8192 MiB limit");
+}
+
+// A file cut anywhere (its header included: OpenVDB's own reader takes a cut header for a file with
+// no grids) says it is truncated or corrupt, in one printable line of bounded length (OpenVDB's
+// messages can quote the file's bytes); a valid file with no grids says that.
+TEST(VdbErrors, CutFilesAreTruncatedAndAFileWithoutGridsSaysSo) {
+  TempDir dir;
+  const std::string whole = dir.file("whole.vdb"), cut = dir.file("cut.vdb");
+  narval::writeVdbTestFile(whole, "affine");
+  const std::string bytes = readFile(whole);
+  const std::string unreadable = cut + ": not a readable OpenVDB file: truncated, corrupt or of another format (";
+  for (size_t n = 1; n < bytes.size(); n += (n < 256 ? 1 : 97)) {
+    writeFile(cut, bytes.substr(0, n));
+    const std::string msg = inputErrorOf([&] { narval::loadVdb(cut, "density"); });
+    EXPECT_EQ(msg.rfind(unreadable, 0), 0u) << n << " bytes: " << msg;
+    EXPECT_LE(msg.size(), unreadable.size() + 170) << n << " bytes: " << msg;
+    EXPECT_TRUE(std::all_of(msg.begin(), msg.end(), [](char c) { return c >= 0x20 && c < 0x7f; })) << n;
+  }
+  const std::string none = dir.file("none.vdb");
+  narval::writeVdbTestFile(none, "no grids");
+  EXPECT_EQ(inputErrorOf([&] { narval::loadVdb(none, "density"); }),
+            none + ": grid: no grid named 'density' (the file has no grids)");
 }
 
 TEST(VdbTransform, AffineMapIsComposedWithTheBoundingBoxShift) {
