@@ -3,10 +3,11 @@
 #                     [--algorithms "pathtrace raymarch"]
 # Cost model (issue 6, item 5): how render time grows with each factor, one factor at a time around
 # a base configuration of scenes/cloud.json (generated 128³ cloud, density 5):
-#   pathtrace (base 160x80, 16 spp, 8 bounces): pixels 80x40..640x320, spp 4..64, bounces 1..32,
+#   pathtrace (base 160x80, 16 spp, the scene's bounces): pixels 80x40..640x320, spp 4..64, bounces 1..32,
 #             density multiplier ×0.25..×8 (materials.N.density), the same with --majorant global
 #             (no DDA: delta tracking's textbook cost, for comparison), grid 64³..512³ (generated clouds);
-#   raymarch  (base 320x160, 60 steps, 10 shadow steps): pixels, steps 15..240, density, grid.
+#   raymarch  (base 320x160, the scene's steps and shadow steps): pixels, steps 15..240, density, grid.
+# The scene's values (bounces, steps, the volume's density) are narval's: `narval scene --resolved`.
 # Generated clouds: `narval make-cloud --resolution G` (default seed, as scenes/data/cloud_128.vdb)
 # into a temporary folder, swapped in with `--set materials.N.path=...`.
 # Per series: pathtrace points run once with --counters first (collisions_tentative,
@@ -31,24 +32,15 @@ out=build/cost_model
 device=""
 scene=scenes/cloud.json
 algorithms="pathtrace raymarch"
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --quick) quick=1; shift ;;
-    --reps) reps=$2; shift 2 ;;
-    --out) out=$2; shift 2 ;;
-    --device) device="--device $2"; shift 2 ;;
-    --scene) scene=$2; shift 2 ;;
-    --algorithms) algorithms=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
+. bench/bench_common.sh
+bench_options "quick! reps out device scene algorithms" "$@"
 if [ ! -x "$narval" ]; then
   echo "no narval binary at $narval (set NARVAL_BIN, or build: cmake --build build --target narval)" >&2
   exit 2
 fi
 
 if [ "$quick" = 1 ]; then
-  pt_res=80x40; pt_spp=4; pt_bounces=8; rm_res=80x40; rm_steps=60
+  pt_res=80x40; pt_spp=4; rm_res=80x40
   [ "$reps" = 3 ] && reps=1
   pixels="40x20 80x40 160x80"
   spps="2 4 8"
@@ -57,7 +49,7 @@ if [ "$quick" = 1 ]; then
   grids="32 64 128"
   steps="15 60 240"
 else
-  pt_res=160x80; pt_spp=16; pt_bounces=8; rm_res=320x160; rm_steps=60
+  pt_res=160x80; pt_spp=16; rm_res=320x160
   pixels="80x40 160x80 320x160 640x320"
   spps="4 8 16 32 64"
   bounces="1 2 4 8 16 32"
@@ -80,13 +72,16 @@ raw="$out/raw.json"
 start=$(date +%s.%N)
 load_start=$(cat /proc/loadavg)
 
-# The volume material of the scene (the one the volume primitive uses) and its density.
-read -r mat density0 < <(python3 - "$scene" <<'PY'
-import json, sys
-s = json.load(open(sys.argv[1]))
+# The volume material of the scene (the one the volume primitive uses), its density, the scene's
+# bounces and the ray marcher's steps, as narval resolves them.
+read -r mat density0 pt_bounces rm_steps < <(python3 - "$narval" "$scene" <<'PY'
+import sys
+sys.path.insert(0, "bench")
+from scene_env import resolved_scene
+s = resolved_scene(sys.argv[1], sys.argv[2])
 name = next(p["materialName"] for p in s["primitives"] if p["type"] == "volume")
-i = next(i for i, m in enumerate(s["materials"]) if m.get("name") == name)
-print(i, s["materials"][i].get("density", 1))
+i = next(i for i, m in enumerate(s["materials"]) if m["name"] == name)
+print(i, s["materials"][i]["density"], s["renderer"]["bounces"], s["renderer"]["raymarch"]["steps"])
 PY
 )
 

@@ -18,17 +18,8 @@ resolution=160x120
 spp=16
 frames=5
 reps=3
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --device) device="--device $2"; shift 2 ;;
-    --resolution) resolution=$2; shift 2 ;;
-    --spp) spp=$2; shift 2 ;;
-    --frames) frames=$2; shift 2 ;;
-    --reps) reps=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
 . bench/bench_common.sh
+bench_options "device resolution spp frames reps" "$@"
 bench_init
 
 # The fire without its emission object, beside the original (so its relative volume path holds).
@@ -41,15 +32,7 @@ json.dump(s, open(sys.argv[2], "w"), indent=2)
 PY
 trap 'rm -rf "$work" scenes/.fire_no_emission.json' EXIT
 
-run() {  # scene algorithm extra-set(or "") -> seconds
-  local scene=$1 alg=$2 set=$3 extra
-  if [ "$alg" = pathtrace ]; then extra="--spp $spp"; else extra="--frames $frames"; fi
-  [ -n "$set" ] && extra="$extra --set $set"
-  # shellcheck disable=SC2086
-  "$narval" render "$scene" -o "$work/out.exr" --algorithm "$alg" --resolution "$resolution" $extra $device \
-    --stats-json "$work/s.json" >/dev/null 2>&1
-  bench_seconds "$work/s.json" "$alg"
-}
+run() { bench_time "$1" "$2" ${3:+--set "$3"}; }  # scene algorithm [--set value] -> seconds
 
 # The index of a scene's volume material, for --set.
 volume_material() {
@@ -65,21 +48,7 @@ echo
 echo "| scene | algorithm | with emission code s (median) | without s (median) | ratio with/without | per-repetition |"
 echo "|---|---|---|---|---|---|"
 compare() {  # label alg with-scene with-set without-scene without-set
-  local label=$1 alg=$2 ws=$3 wset=$4 os=$5 oset=$6 w=() o=()
-  run "$ws" "$alg" "$wset" >/dev/null
-  run "$os" "$alg" "$oset" >/dev/null
-  for _ in $(seq "$reps"); do
-    w+=("$(run "$ws" "$alg" "$wset")")
-    o+=("$(run "$os" "$alg" "$oset")")
-  done
-  python3 - "$label" "$alg" "${w[*]}" "${o[*]}" <<'PY'
-import statistics, sys
-label, alg = sys.argv[1], sys.argv[2]
-w, o = [float(x) for x in sys.argv[3].split()], [float(x) for x in sys.argv[4].split()]
-mw, mo = statistics.median(w), statistics.median(o)
-per = ", ".join("%.3f" % (a / b) for a, b in zip(w, o))
-print(f"| {label} | {alg} | {mw:.4f} | {mo:.4f} | {mw / mo:.3f} | {per} |")
-PY
+  bench_ab "$1 | $2" 4 3 run "$3 $2 $4" "$5 $2 $6"
 }
 for alg in pathtrace raymarch lobe; do
   compare "fire: emitting / emission removed" "$alg" scenes/fire.json "" scenes/.fire_no_emission.json ""

@@ -15,16 +15,8 @@ scene=scenes/disney_cloud.json
 resolution=1200x600
 spp=16
 tasks="1 2 4 8"
-while [ $# -gt 0 ]; do
-  case $1 in
-    --scene) scene=$2; shift 2;;
-    --resolution) resolution=$2; shift 2;;
-    --spp) spp=$2; shift 2;;
-    --tasks) tasks=$2; shift 2;;
-    *) echo "farm_scaling.sh: unknown option $1" >&2; exit 2;;
-  esac
-done
-source bench/bench_common.sh
+. bench/bench_common.sh
+bench_options "scene resolution spp tasks" "$@"
 bench_init
 chmod a+x "$work"  # munged wants every folder above its socket traversable
 bash tests/farm/slurm_cluster.sh start "$work/cluster" >/dev/null

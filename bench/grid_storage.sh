@@ -19,29 +19,11 @@ spp=16
 frames=5
 reps=3
 algorithms="pathtrace raymarch"
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --device) device="--device $2"; shift 2 ;;
-    --scene) scene=$2; shift 2 ;;
-    --resolution) resolution=$2; shift 2 ;;
-    --spp) spp=$2; shift 2 ;;
-    --frames) frames=$2; shift 2 ;;
-    --reps) reps=$2; shift 2 ;;
-    --algorithms) algorithms=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
 . bench/bench_common.sh
+bench_options "device scene resolution spp frames reps algorithms" "$@"
 bench_init
 
-run() {  # algorithm storage -> seconds (pathtrace: kernel seconds; others: median kernel s per frame)
-  local alg=$1 storage=$2 extra
-  if [ "$alg" = pathtrace ]; then extra="--spp $spp"; else extra="--frames $frames"; fi
-  # shellcheck disable=SC2086
-  "$narval" render "$scene" -o "$work/$alg-$storage.exr" --algorithm "$alg" --resolution "$resolution" $extra \
-    $device --set "renderer.storage=$storage" --stats-json "$work/s.json" >/dev/null
-  bench_seconds "$work/s.json" "$alg"
-}
+run() { bench_time "$scene" "$1" --set "renderer.storage=$2"; }  # algorithm storage -> seconds
 
 run "${algorithms%% *}" buffer >/dev/null  # also warms up the first algorithm's buffer program
 echo "device: $(bench_device "$work/s.json")"
@@ -50,19 +32,5 @@ echo
 echo "| algorithm | image s (median) | buffer s (median) | image/buffer | per-repetition image/buffer |"
 echo "|---|---|---|---|---|"
 for alg in $algorithms; do
-  run "$alg" image >/dev/null  # warm-up: build (or cache load) and first launch of each program
-  run "$alg" buffer >/dev/null
-  image=()
-  buffer=()
-  for _ in $(seq "$reps"); do
-    image+=("$(run "$alg" image)")
-    buffer+=("$(run "$alg" buffer)")
-  done
-  python3 - "$alg" "${image[*]}" "${buffer[*]}" <<'PY'
-import statistics, sys
-alg, img, buf = sys.argv[1], [float(x) for x in sys.argv[2].split()], [float(x) for x in sys.argv[3].split()]
-mi, mb = statistics.median(img), statistics.median(buf)
-per = ", ".join("%.2f" % (i / b) for i, b in zip(img, buf))
-print(f"| {alg} | {mi:.3f} | {mb:.3f} | {mi / mb:.2f} | {per} |")
-PY
+  bench_ab "$alg" 3 2 run "$alg image" "$alg buffer"
 done

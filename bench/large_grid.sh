@@ -22,19 +22,8 @@ frames=3
 storages="auto bricks"
 device=""
 keep=""
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --resolution) resolution=$2; shift 2 ;;
-    --seed) seed=$2; shift 2 ;;
-    --image) image=$2; shift 2 ;;
-    --spp) spp=$2; shift 2 ;;
-    --frames) frames=$2; shift 2 ;;
-    --storages) storages=$2; shift 2 ;;
-    --device) device="--device $2"; shift 2 ;;
-    --keep) keep=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
+. bench/bench_common.sh
+bench_options "resolution seed image spp frames storages device keep" "$@"
 if [ "$narval" = build/narval ] && [ ! -x build/narval ]; then scripts/setup.sh >/dev/null; fi
 [ -x /usr/bin/time ] || { echo "needs GNU time (/usr/bin/time): apt-get install time" >&2; exit 1; }
 if [ -n "$keep" ]; then

@@ -13,7 +13,7 @@
 # - the cost of counting: the default grid with and without --counters, same alternation.
 # - raymarch (empty-space skipping with the same cells): median kernel ms per frame of K frames.
 # Not a test: nothing is asserted. NARVAL=path/to/narval picks the binary (default build/narval).
-# The Disney cloud scene reads ${NARVAL_DATA_DIR:-../shared/data/volumes}; a scene whose data is
+# The Disney cloud scene reads its grid where scenes/disney_cloud.json says; a scene whose data is
 # absent is skipped with a note.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,19 +25,8 @@ spp=16
 reps=3
 cells="8 16 32 64"
 frames=5
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --device) device="--device $2"; shift 2 ;;
-    --scenes) scenes=$2; shift 2 ;;
-    --resolution) resolution=$2; shift 2 ;;
-    --spp) spp=$2; shift 2 ;;
-    --reps) reps=$2; shift 2 ;;
-    --cells) cells=$2; shift 2 ;;
-    --frames) frames=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
 . bench/bench_common.sh
+bench_options "device scenes resolution spp reps cells frames" "$@"
 bench_init
 
 # config name -> CLI options

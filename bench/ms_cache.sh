@@ -13,28 +13,17 @@ frames=3
 resolution=320x240
 ref_spp=256
 scenes="scenes/cloud.json scenes/smoke.json scenes/disney_cloud.json scenes/listing_4_1.json"
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --frames) frames=$2; shift 2 ;;
-    --resolution) resolution=$2; shift 2 ;;
-    --ref-spp) ref_spp=$2; shift 2 ;;
-    --scenes) scenes=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
-# shellcheck source=bench/bench_common.sh
 . bench/bench_common.sh
+bench_options "frames resolution ref_spp scenes" "$@"
 bench_init
 refs=build/realtime_frames
 mkdir -p "$refs"
 
-# ref SCENE SEED: the reference's path (rendered unless there).
+# ref SCENE SEED: the reference's path (bench_reference: rendered unless it is there).
 ref() {
-  local name out
-  name=$(basename "$1" .json)
-  out="$refs/ref-$name-$resolution-${ref_spp}spp$([ "$2" = 0 ] || echo "-seed$2").exr"
-  [ -f "$out" ] || "$narval" render "$1" -o "$out" --algorithm pathtrace --spp "$ref_spp" --resolution "$resolution" \
-    --seed "$2" >/dev/null 2>&1
+  local out
+  out="$refs/ref-$(basename "$1" .json)-$resolution-${ref_spp}spp$([ "$2" = 0 ] || echo "-seed$2").exr"
+  bench_reference "$out" "$1" --spp "$ref_spp" --resolution "$resolution" --seed "$2"
   echo "$out"
 }
 delta() {  # REF TEST -> "mean ΔE76 | JND%"

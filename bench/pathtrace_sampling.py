@@ -23,29 +23,31 @@ import json
 import os
 import shlex
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 
+from scene_env import NarvalError, key_table, run_narval
+
 DEFAULT_SCENES = ["scenes/cloud.json", "scenes/disney_cloud.json", "scenes/disney_cloud_front.json",
                   "scenes/smoke.json", "scenes/dragon.json"]
 NO_ROULETTE = "--set renderer.pathtrace.shadowRoulette=0"
-ROULETTE = "--set renderer.pathtrace.shadowRoulette=0.05"
-DEFAULT_CONFIGS = [
-    ("all", f"--set renderer.pathtrace.lightSampling=all {NO_ROULETTE}"),
-    ("power", f"--set renderer.pathtrace.lightSampling=power {NO_ROULETTE}"),
-    ("fluence", f"--set renderer.pathtrace.lightSampling=fluence {NO_ROULETTE}"),
-    ("all+roulette", f"--set renderer.pathtrace.lightSampling=all {ROULETTE}"),
-    ("fluence+roulette", f"--set renderer.pathtrace.lightSampling=fluence {ROULETTE}"),
-]
+
+
+def default_configs(narval):
+    """The sampling choices; "roulette" is shadow-ray roulette at the loader's default (scene --keys)."""
+    roulette = "--set renderer.pathtrace.shadowRoulette=%s" % json.dumps(
+        key_table(narval)["renderer.pathtrace.shadowRoulette"]["defaults"][0])
+    return [(name, f"--set renderer.pathtrace.lightSampling={mode} {roulette if rr else NO_ROULETTE}")
+            for name, mode, rr in [("all", "all", 0), ("power", "power", 0), ("fluence", "fluence", 0),
+                                   ("all+roulette", "all", 1), ("fluence+roulette", "fluence", 1)]]
 
 
 def run(cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit(f"pathtrace_sampling: {' '.join(shlex.quote(c) for c in cmd)} failed ({r.returncode}):\n{r.stderr}")
-    return r.stdout
+    try:
+        return run_narval(cmd[0], cmd[1:])
+    except NarvalError as e:
+        sys.exit(f"pathtrace_sampling: {e}")
 
 
 def render(a, scene, out, spp, seed, extra, counters=False):
@@ -92,9 +94,8 @@ def main():
     p.add_argument("--cache", default="build/bench-cache")
     p.add_argument("--json", default="")
     a = p.parse_args()
-    configs = DEFAULT_CONFIGS
-    if a.configs:
-        configs = [tuple(c.split("=", 1)) if "=" in c else (c, "") for c in a.configs.split(";")]
+    configs = ([tuple(c.split("=", 1)) if "=" in c else (c, "") for c in a.configs.split(";")] if a.configs
+               else default_configs(a.narval))
     results = {}
     with tempfile.TemporaryDirectory() as tmp:
         for scene in a.scenes.split(","):

@@ -9,17 +9,10 @@ cd "$(dirname "$0")/.."
 device=""
 spp=16
 resolution=320x160
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --device) device="--device $2"; shift 2 ;;
-    --spp) spp=$2; shift 2 ;;
-    --resolution) resolution=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
-[ -x build/narval ] || scripts/setup.sh >/dev/null
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. bench/bench_common.sh
+bench_options "device spp resolution" "$@"
+narval=build/narval
+bench_init
 
 row() {  # name scene extra-args...
   local name=$1 scene=$2; shift 2
@@ -40,11 +33,11 @@ echo "device: $(build/narval devices | sed -n 2p)"
 echo
 echo "| scene | resolution | spp | bounces | seconds | kernel s | Msamples/s |"
 echo "|---|---|---|---|---|---|---|"
-data=${NARVAL_DATA_DIR:-../shared/data/volumes}
-if [ -f "$data/wdas_cloud_sixteenth.vdb" ]; then
+missing=$(bench_missing scenes/disney_cloud.json)
+if [ -z "$missing" ]; then
   row disney_cloud scenes/disney_cloud.json
 else
-  echo "| disney_cloud | skipped: $data/wdas_cloud_sixteenth.vdb absent | | | | | |"
+  echo "| disney_cloud | skipped: $missing absent | | | | | |"
 fi
 for n in 64 128 256; do
   build/narval make-cloud "$work/cloud_$n.vdb" --resolution "$n" --seed 1 >/dev/null

@@ -5,8 +5,8 @@
 # Real-time kernels with and without the light-transmittance cache (renderer.lightCache). For each
 # scene, resolution and kernel (raymarch, lobe): the median kernel ms per frame of K frames after
 # the first (build and warm-up reported apart by narval itself) with the cache off
-# (renderer.lightCache.resolution=0: exact shadow marching) and on (the scene's setting, default
-# "auto"); the cache's build time (light_cache_ms, apart from the frames), cells and builds; mean
+# (renderer.lightCache.resolution=0: exact shadow marching) and on (the scene's setting, as narval
+# resolves it); the cache's build time (light_cache_ms, apart from the frames), cells and builds; mean
 # ΔE76 and JND% of the cache-on image against the cache-off image of the same kernel (what the
 # cache costs) and against a path-traced reference (REF_SPP spp, the scene's bounces) at the same
 # resolution. References are rendered once per scene and resolution listed in --ref-resolutions and
@@ -79,51 +79,6 @@ mkdir -p "$out"
 rows="$work/rows.jsonl"
 : >"$rows"
 
-# missing_data SCENE: prints the scene's volume files that are absent (none: prints nothing), with
-# ${VAR} and ${VAR:-default} expanded as the scene loader does (host/scene/scene_path.h) and
-# relative paths taken from the scene's folder. A path it cannot make sense of is left to narval.
-missing_data() {
-  python3 - "$1" <<'PY'
-import json, os, re, sys
-scene = sys.argv[1]
-def expand(s):
-    out, i = "", 0
-    while i < len(s):
-        if not s.startswith("${", i):
-            out, i = out + s[i], i + 1
-            continue
-        depth, j = 0, i
-        while j < len(s):
-            if s.startswith("${", j):
-                depth, j = depth + 1, j + 2
-                continue
-            if s[j] == "}":
-                depth -= 1
-                if depth == 0:
-                    break
-            j += 1
-        m = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)(:-(.*))?", s[i + 2:j], re.S)
-        if j >= len(s) or not m:
-            raise ValueError(s)
-        v = os.environ.get(m.group(1), "")
-        if not v and m.group(2) is not None:
-            v = expand(m.group(3))
-        elif not v and m.group(1) not in os.environ:
-            raise ValueError(s)
-        out, i = out + v, j + 1
-    return out
-for m in json.load(open(scene)).get("materials", []):
-    if m.get("type") == "volume" and isinstance(m.get("path"), str):
-        try:
-            p = expand(m["path"])
-        except ValueError:
-            continue
-        full = p if os.path.isabs(p) else os.path.join(os.path.dirname(scene), p)
-        if not os.path.isfile(full):
-            print(os.path.normpath(full))
-PY
-}
-
 # in_list WORD LIST...: whether WORD is one of LIST.
 in_list() { local w=$1 x; shift; for x in "$@"; do [ "$x" = "$w" ] && return 0; done; return 1; }
 
@@ -136,23 +91,11 @@ render_rt() {
     "${device[@]}" "${extra[@]}" --stats-json "$out/$5.json" >/dev/null
 }
 
-# reference SCENE RES STEM: the path-traced reference $out/STEM.exr, reused when it is already
-# there with REF_SPP spp from the same settings (--resume renders nothing then, or only the
-# missing samples of an interrupted render); rendered again when it came from other settings.
+# reference SCENE RES STEM: the path-traced reference $out/STEM.exr (bench_reference: kept between
+# runs, completed when interrupted, rendered again when it came from other settings).
 reference() {
-  local exr="$out/$3.exr"
-  if [ -f "$exr" ]; then
-    echo "  $(basename "$1" .json) $2 reference: reusing or completing $exr" >&2
-    if "$narval" render "$1" -o "$exr" --algorithm pathtrace --spp "$ref_spp" --resolution "$2" \
-      "${device[@]}" --resume >/dev/null; then
-      return 0
-    fi
-    echo "  $exr is from other settings: rendering it again" >&2
-  else
-    echo "  $(basename "$1" .json) $2 reference: pathtrace $ref_spp spp" >&2
-  fi
-  "$narval" render "$1" -o "$exr" --algorithm pathtrace --spp "$ref_spp" --resolution "$2" \
-    "${device[@]}" >/dev/null
+  echo "  $(basename "$1" .json) $2 reference: pathtrace $ref_spp spp (reused when it is there)" >&2
+  bench_reference "$out/$3.exr" "$1" --spp "$ref_spp" --resolution "$2" "${device[@]}"
 }
 
 # compare REF TEST JSON: narval compare's statistics into JSON, linear (no tone mapping, exposure 0:
@@ -166,7 +109,7 @@ for scene in "${scene_list[@]}"; do
       "$name" "skipped: $scene absent" >>"$rows"
     continue
   fi
-  missing=$(missing_data "$scene")
+  missing=$(bench_missing "$scene")
   if [ -n "$missing" ]; then
     python3 -c 'import json,sys; print(json.dumps({"scene": sys.argv[1], "skip": sys.argv[2]}))' \
       "$name" "skipped: $(echo "$missing" | paste -sd, -) absent" >>"$rows"
@@ -241,7 +184,7 @@ print()
 print("ms: median kernel ms per frame (OpenCL profiling events) of the %d frame(s) after the first "
       "(`--frames %s`; the first pays for the build and warm-up); cache off: "
       "`--set renderer.lightCache.resolution=0` (exact shadow marching), cache on: the scene's setting "
-      "(default auto). Cache build ms (`light_cache_ms`, all builds of one render, not in the frame times), "
+      "(as narval resolves it). Cache build ms (`light_cache_ms`, all builds of one render, not in the frame times), "
       "cells (x×y×z) and builds (`light_cache_builds`) are the cache-on render's. ΔE76: mean over pixels, "
       "JND%%: pixels with ΔE76 > 2.3, by `narval compare` with its default display transform (none: linear "
       "values clipped to [0, 1]). on vs off: the cache-on image against the cache-off image of the same "

@@ -24,9 +24,10 @@ Exit 2 with one line on bad usage; 1 when a narval command fails (its stderr is 
 import argparse
 import json
 import os
-import subprocess
 import sys
 from pathlib import Path
+
+from scene_env import NarvalError, run_json, run_narval
 
 REPO = Path(__file__).resolve().parent.parent
 RESOLUTION = "320x240"
@@ -34,24 +35,20 @@ SCENES = [("cloud", "scenes/cloud.json"), ("smoke", "scenes/smoke.json"),
           ("disney_cloud", "scenes/disney_cloud.json"), ("disney_cloud_front", "scenes/disney_cloud_front.json")]
 
 
-def view_cache(tile, paths, sigma, tolerance, guide=0.0, twicing=False, allocation="even"):
-    """The view cache with the direct light, the filter (twiced or not), the guide and the paths'
-    allocation over the columns (README, bench/RESULTS.md)."""
+def view_cache(tile, paths, sigma, tolerance, **more):
+    """The view cache with the direct light and the filter; `more`: other renderer.raymarch.msCache
+    keys (guide, filterTwicing, allocation), set only where a pick names them (README,
+    bench/RESULTS.md). The rest is the scene's as narval resolves it."""
+    cache = dict(layout="view", direct=True, tile=tile, paths=paths, filter=sigma, filterTolerance=tolerance, **more)
     return ["--algorithm", "raymarch", "--set", 'renderer.raymarch.multipleScattering="cache"',
-            "--set", 'renderer.raymarch.msCache.layout="view"', "--set", "renderer.raymarch.msCache.direct=true",
-            "--set", "renderer.raymarch.msCache.tile=%d" % tile, "--set", "renderer.raymarch.msCache.paths=%d" % paths,
-            "--set", "renderer.raymarch.msCache.filter=%g" % sigma,
-            "--set", "renderer.raymarch.msCache.filterTolerance=%g" % tolerance,
-            "--set", "renderer.raymarch.msCache.filterTwicing=%s" % ("true" if twicing else "false"),
-            "--set", "renderer.raymarch.msCache.guide=%g" % guide,
-            "--set", 'renderer.raymarch.msCache.allocation="%s"' % allocation,
-            "--set", "renderer.raymarch.steps=30"]
+            "--set", "renderer.raymarch.steps=30"] + [
+        a for k, v in cache.items() for a in ("--set", "renderer.raymarch.msCache.%s=%s" % (k, json.dumps(v)))]
 
 
 # The cache's pick per scene (a build under 60 s on 2 CPU cores; bench/RESULTS.md).
 CACHE_PICKS = {"cloud": view_cache(1, 100, 1.5, 2), "smoke": view_cache(1, 100, 1.5, 2),
-               "disney_cloud": view_cache(1, 136, 1.5, 2, twicing=True, allocation="perceptual"),
-               "disney_cloud_front": view_cache(2, 480, 2, 0.5, 0.15)}
+               "disney_cloud": view_cache(1, 136, 1.5, 2, filterTwicing=True, allocation="perceptual"),
+               "disney_cloud_front": view_cache(2, 480, 2, 0.5, guide=0.15)}
 METHODS = [
     ("raymarch, single scattering", lambda scene: ["--algorithm", "raymarch", "--set",
                                                    'renderer.raymarch.multipleScattering="none"']),
@@ -61,21 +58,9 @@ METHODS = [
 ]
 
 
-class NarvalError(Exception):
-    """A narval command failed; the message carries the command and its stderr."""
-
-
 def usage_error(message):
     print("realtime_picture: " + message, file=sys.stderr)
     sys.exit(2)
-
-
-def run_narval(narval, args):
-    command = [str(narval)] + [str(a) for a in args]
-    done = subprocess.run(command, cwd=REPO, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise NarvalError("%s failed (exit %d):\n%s" % (" ".join(command), done.returncode, done.stderr.strip()))
-    return done.stdout
 
 
 def exr_int_attribute(path, name):
@@ -120,7 +105,7 @@ def reference(settings, name, scene):
         args.append("--resume")
     print("realtime_picture: rendering the reference %s from %d to %d spp" % (exr, have, settings.reference_spp),
           flush=True)
-    run_narval(settings.narval, args)
+    run_narval(settings.narval, args, cwd=REPO)
     return exr, png
 
 
@@ -129,10 +114,10 @@ def measure(settings, name, scene, index, options, ref_exr):
     out = settings.work / ("%s_%d.exr" % (name, index))
     stats = out.with_suffix(".json")
     run_narval(settings.narval, ["render", scene, "-o", out, "--resolution", RESOLUTION, "--frames", settings.frames,
-                                 "--seed", 1, "--stats-json", stats] + options)
+                                 "--seed", 1, "--stats-json", stats] + options, cwd=REPO)
     with open(stats) as f:
         s = json.load(f)
-    c = json.loads(run_narval(settings.narval, ["compare", ref_exr, out, "--json"]))
+    c = run_json(settings.narval, ["compare", ref_exr, out, "--json"], cwd=REPO)
     caption = "%.0f ms" % s["ms_per_frame"]["median"]
     if s.get("ms_cache_builds", 0) > 0:
         caption += " + %.0f s build" % (s["ms_cache_ms"] / 1000.0)

@@ -13,22 +13,13 @@ narval=build/narval
 device=""
 frames=5
 resolution=320x240
-data=${NARVAL_DATA_DIR:-../shared/data/volumes}
 scenes="scenes/listing_4_1.json scenes/disney_cloud.json scenes/cloud.json scenes/smoke.json"
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --device) device="--device $2"; shift 2 ;;
-    --frames) frames=$2; shift 2 ;;
-    --resolution) resolution=$2; shift 2 ;;
-    --scenes) scenes=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
-# shellcheck source=bench/bench_common.sh
 . bench/bench_common.sh
+bench_options "device frames resolution scenes" "$@"
 bench_init
 
-# render SCENE ALGORITHM NAME SET... : renders into $work/NAME.exr; prints "ms build_ms".
+# render SCENE ALGORITHM NAME SET... : renders into $work/NAME.exr; prints "ms build_ms cells" (the
+# light cache's cells along its longest axis).
 render() {
   local scene=$1 algorithm=$2 name=$3
   shift 3
@@ -37,7 +28,7 @@ render() {
   # shellcheck disable=SC2086
   "$narval" render "$scene" -o "$work/$name.exr" --algorithm "$algorithm" --resolution "$resolution" \
     --frames "$frames" $device "${sets[@]}" --stats-json "$work/$name.json" >/dev/null 2>&1
-  python3 -c "import json,sys; s=json.load(open(sys.argv[1])); print('%.1f %.1f' % (s['ms_per_frame']['median'], s['light_cache_ms']))" \
+  python3 -c "import json,sys; s=json.load(open(sys.argv[1])); print('%.1f %.1f %d' % (s['ms_per_frame']['median'], s['light_cache_ms'], max(s['light_cache_cells'])))" \
     "$work/$name.json"
 }
 # delta REF TEST: "mean ΔE76 | JND%"
@@ -50,10 +41,8 @@ echo "device: $("$narval" devices | sed -n 2p)"
 echo "command: bench/realtime_tuning.sh --frames $frames --resolution $resolution"
 for scene in $scenes; do
   name=$(basename "$scene" .json)
-  if grep -q 'NARVAL_DATA_DIR' "$scene"; then
-    file=$(python3 -c "import json,sys,os; m=[m for m in json.load(open(sys.argv[1]))['materials'] if 'path' in m][0]; print(os.path.basename(m['path']))" "$scene")
-    if [ ! -f "$data/$file" ]; then echo; echo "## $name: skipped, $data/$file absent"; continue; fi
-  fi
+  missing=$(bench_missing "$scene" | paste -sd, -)
+  if [ -n "$missing" ]; then echo; echo "## $name: skipped, $missing absent"; continue; fi
   echo
   echo "## $name ($resolution)"
   echo
@@ -63,16 +52,16 @@ for scene in $scenes; do
     read -r ms _ < <(render "$scene" "$algorithm" "$algorithm-exact" renderer.lightCache.resolution=0)
     echo "| $algorithm | cache off (exact) | $ms | — | 0 | 0% |"
     for cells in 16 32 64 96 128; do
-      read -r ms build < <(render "$scene" "$algorithm" "$algorithm-$cells" "renderer.lightCache.resolution=$cells")
+      read -r ms build _ < <(render "$scene" "$algorithm" "$algorithm-$cells" "renderer.lightCache.resolution=$cells")
       echo "| $algorithm | cache $cells | $ms | $build | $(delta "$algorithm-exact" "$algorithm-$cells") |"
     done
-    read -r ms _ < <(render "$scene" "$algorithm" "$algorithm-noterm" renderer.raymarch.minTransmittance=0 \
+    read -r ms _ auto < <(render "$scene" "$algorithm" "$algorithm-noterm" renderer.raymarch.minTransmittance=0 \
       renderer.lobe.minTransmittance=0)
-    echo "| $algorithm | cache 64, minTransmittance 0 | $ms | | 0 | 0% |"
+    echo "| $algorithm | cache $auto, minTransmittance 0 | $ms | | 0 | 0% |"
     for eps in 1e-4 1e-3; do
       read -r ms _ < <(render "$scene" "$algorithm" "$algorithm-term$eps" "renderer.raymarch.minTransmittance=$eps" \
         "renderer.lobe.minTransmittance=$eps")
-      echo "| $algorithm | cache 64, minTransmittance $eps | $ms | | $(delta "$algorithm-noterm" "$algorithm-term$eps") |"
+      echo "| $algorithm | cache $auto, minTransmittance $eps | $ms | | $(delta "$algorithm-noterm" "$algorithm-term$eps") |"
     done
   done
   read -r ms _ < <(render "$scene" lobe lobe-view100 renderer.lobe.viewSteps=100)

@@ -10,7 +10,7 @@
 # frame of K frames. Prints a Markdown table of the medians and the speed-up (generic / specialised)
 # with the per-repetition ratios. Not a test: nothing is asserted.
 # NARVAL=path/to/narval picks the binary (default build/narval). The Disney cloud is read from
-# NARVAL_DATA_DIR (default ../shared/data/volumes, see scenes/disney_cloud.json).
+# NARVAL_DATA_DIR (where scenes/disney_cloud.json looks).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 narval=${NARVAL:-build/narval}
@@ -21,29 +21,11 @@ spp=16
 frames=5
 reps=3
 algorithms="pathtrace raymarch"
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --device) device="--device $2"; shift 2 ;;
-    --scenes) scenes=$2; shift 2 ;;
-    --resolution) resolution=$2; shift 2 ;;
-    --spp) spp=$2; shift 2 ;;
-    --frames) frames=$2; shift 2 ;;
-    --reps) reps=$2; shift 2 ;;
-    --algorithms) algorithms=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
 . bench/bench_common.sh
+bench_options "device scenes resolution spp frames reps algorithms" "$@"
 bench_init
 
-run() {  # scene algorithm generic(0|1) -> seconds
-  local scene=$1 alg=$2 generic=$3 extra
-  if [ "$alg" = pathtrace ]; then extra="--spp $spp"; else extra="--frames $frames"; fi
-  # shellcheck disable=SC2086
-  NARVAL_GENERIC=$generic "$narval" render "$scene" -o "$work/out.exr" --algorithm "$alg" \
-    --resolution "$resolution" $extra $device --stats-json "$work/s.json" >/dev/null
-  bench_seconds "$work/s.json" "$alg"
-}
+run() { NARVAL_GENERIC=$3 bench_time "$1" "$2"; }  # scene algorithm generic(0|1) -> seconds
 
 first=${scenes%% *}
 run "$first" "${algorithms%% *}" 0 >/dev/null
@@ -56,22 +38,7 @@ echo "| scene | algorithm | specialised s (median) | generic s (median) | speed-
 echo "|---|---|---|---|---|---|"
 for scene in $scenes; do
   for alg in $algorithms; do
-    run "$scene" "$alg" 0 >/dev/null  # warm-up: build (or cache load) and first launch
-    run "$scene" "$alg" 1 >/dev/null
-    spec=()
-    gen=()
-    for _ in $(seq "$reps"); do
-      spec+=("$(run "$scene" "$alg" 0)")
-      gen+=("$(run "$scene" "$alg" 1)")
-    done
-    python3 - "$scene" "$alg" "${spec[*]}" "${gen[*]}" <<'PY'
-import statistics, sys
-scene, alg = sys.argv[1], sys.argv[2]
-sp, ge = [float(x) for x in sys.argv[3].split()], [float(x) for x in sys.argv[4].split()]
-ms, mg = statistics.median(sp), statistics.median(ge)
-per = ", ".join("%.3f" % (g / s) for s, g in zip(sp, ge))
-print(f"| {scene} | {alg} | {ms:.4f} | {mg:.4f} | {mg / ms:.3f} | {per} |")
-PY
+    bench_ab "$scene | $alg" 4 3 run "$scene $alg 0" "$scene $alg 1" inverse
   done
 done
 echo

@@ -2,36 +2,14 @@
 """Speed-versus-error report (issue 4, item 3): bench/speed_vs_error.py [SCENE.json ...] [options]
 
 The path tracer and every real-time option of narval as *methods*: a method is an algorithm with
-fixed scene settings (passed as `--set renderer.ALGORITHM.KEY=JSON`, strings JSON-quoted), base
-parameters and sweeps (full mode; each sweep varies one parameter from the base):
-  pathtrace         spp 1,4,16,64,256; bounces 1,2,4,8 (base: --base-spp, the scene's bounces)
-  raymarch-none     multipleScattering "none", octaves 1: steps 15,30,60,120; shadowSteps 5,10,20
-  raymarch-octaves  multipleScattering "octaves": octaves 2,4,8 (base 4); steps 30,60,120
-  raymarch-cache    multipleScattering "cache", octaves 1: msCache.resolution 8,16,32 (base 16);
-                    msCache.paths 64,256,1024 (base 256); steps 30,60,120; shadowAreaSamples 1,4;
-                    areaLightSamples 1,2; areaLightPhase points,exact; msCache.closure linear,hg
-  raymarch-cache-camera  the same with msCache.closure "camera" (the cache's paths aimed at the
-                    camera): msCache.resolution 16,32; msCache.paths 256,1024; areaLightPhase points,exact;
-                    msCache.interpolation geometric,linear
-  raymarch-cache-view    the cache laid out in view space (msCache.layout "view": columns over the
-                    image, nodes along their optical depth), the phase over rectangles exact and their
-                    shadows weighted by the phase: msCache.tile 2,4,8 (base 4); msCache.slices 4,8,16
-                    (base 8); msCache.paths 64,256,1024 (base 256); shadowWeighting area,phase (base phase)
-  raymarch-cache-direct  the view-space cache holding the lights' unscattered light too
-                    (msCache.direct: its paths make the path tracer's next-event estimate at their
-                    start; the march makes no light loop): msCache.tile 2,4 (base 2); msCache.slices
-                    4,8 (base 8); msCache.paths 128,256,512 (base 256)
-  raymarch-cache-filtered  the same at tiles of 1 pixel with the filter over its nodes
-                    (msCache.filter: columns averaged where they agree within their noise):
-                    msCache.paths 40,160 (base 160); msCache.filter 1,1.5,2 (base 1);
-                    msCache.filterTolerance 0.5,2,8 (base 2); msCache.filterTwicing false,true
-                    (base false: the filter's residual filtered and added back); msCache.allocation
-                    even,perceptual (base even: the paths spread over the columns by what the eye sees)
-  lobe-eq7          variant "eq7": lobePoints 10,30,60; depthFactor 5,20,100; shadowSteps 25,50,100
-  lobe-corrected    variant "corrected": lobePoints 10,30,60; lobeRadius 0.3,1,3,10; viewSteps 12,24,48
-Base parameters not named above are the scene's (renderer.raymarch / renderer.lobe), else narval's
-defaults (README: raymarch steps 60, shadowSteps 10; lobe lobePoints 30, depthFactor 20, shadowSteps
-100, lobeRadius 1, viewSteps 24). A dotted parameter is a nested key: msCache.resolution is
+fixed scene settings (passed as `--set renderer.ALGORITHM.KEY=JSON`, strings JSON-quoted), named
+base parameters and sweeps (METHODS, FULL_SWEEPS below; each sweep varies one parameter from the
+base). pathtrace sweeps spp (bounces: the scene's) and bounces (spp: --base-spp); the ray marcher
+runs with multiple scattering none, octaves, or its cache (the grid layout, the camera closure, the
+view-space layout, with the lights' direct light, and filtered over its nodes); the lobe as Eq. 7
+and corrected. A base parameter a method does not name is the scene's as narval resolves it
+(`narval scene SCENE --set <the method's settings> --resolved`): the scene's value, else the
+loader's default. A dotted parameter is a nested key: msCache.resolution is
 renderer.raymarch.msCache.resolution.
 
 For each scene (default scenes/cloud.json, scenes/smoke.json, scenes/disney_cloud.json (the Disney
@@ -46,11 +24,11 @@ the front); a scene whose volume file is absent is skipped, saying why):
   2. every method across its sweeps (pathtrace with seed 2, not the reference's). Time: the stats'
      `seconds` per image for pathtrace; per frame for the others, the median of `--frames 3`
      (kernel time by profiling events); each method gets one tiny warm-up render first (PoCL
-     compiles again at the first launch). raymarch-cache(-camera) rows also record `build_seconds`, the
+     compiles again at the first launch). Cache methods' rows also record `build_seconds`, the
      multiple-scattering cache's build (stats `ms_cache_ms`), which is not part of the frame time;
-  3. `narval compare REFERENCE TEST --json` under the scene's display transform (its exposure and
-     tone mapping, as narval's PNG shows it) for mean ΔE76, JND76% (ΔE76 > 2.3), mean ΔE2000 and
-     JND2000%;
+  3. `narval compare REFERENCE TEST --json` under the scene's display transform (the one both EXRs
+     record: its exposure and tone mapping, as narval's PNG shows it) for mean ΔE76, JND76% (ΔE76 >
+     2.3), mean ΔE2000 and JND2000%;
   4. budget picks: per frame budget (--budgets-ms, default 16 and 100 ms), the configuration of a
      real-time method (not pathtrace) with the lowest JND76% whose frame time is within the budget
      (ties: lower mean ΔE76), and whether its JND76% meets --jnd-threshold.
@@ -62,14 +40,7 @@ budgets as verticals), the renders and their PNGs under SCENE/, and report.md + 
 header, methods table; per scene the summary, budget picks, plots, results with a build column and a
 labelled thumbnail grid; a closing budget x scene table). The budget picks are printed at the end.
 
-Options: --resolution WxH (default 320x240), --reference-spp N (default 2048), --reference-bounces N
-(default: the scene's bounces), --base-spp N (pathtrace spp while bounces vary, default 16),
---frames K (default 3), --device SPEC, --jnd-threshold P (default 5, for the summary and the picks),
---methods M1,M2,... (default: all six), --sweep METHOD.PARAMETER=V1,V2,... (replace one sweep, e.g.
-raymarch-cache.msCache.resolution=8,16; repeatable), --budgets-ms B1,B2 (default 16,100),
---refresh-reference, --quick (smoke test: 48x24, reference 64 spp, two values per sweep, base spp 4),
---references-only (render or find the references, then stop), --out DIR, --narval BINARY.
-Reference cache: $NARVAL_CACHE_DIR/speed_vs_error, else ~/.cache/narval/speed_vs_error;
+Options: --help. Reference cache: $NARVAL_CACHE_DIR/speed_vs_error, else ~/.cache/narval/speed_vs_error;
 NARVAL_CACHE_DIR=off renders the reference every time. Python 3 standard library only.
 Not a test: nothing is asserted. Exit codes: 0 done, 1 a narval command failed, 2 bad usage (one
 line on stderr), 130 interrupted.
@@ -85,13 +56,12 @@ import os
 import re
 import shlex
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from scene_env import expand_environment
+from scene_env import NarvalError, run_json, run_narval, resolved_scene, value_at, volume_path
 
 REPO = Path(__file__).resolve().parent.parent
 DEFAULT_SCENES = ["scenes/cloud.json", "scenes/smoke.json", "scenes/disney_cloud.json",
@@ -102,8 +72,9 @@ TEST_SEED = 2
 DEFAULT_BUDGETS_MS = [16, 100]
 
 # A method is an algorithm with fixed scene settings (passed as --set renderer.ALGORITHM.KEY=JSON),
-# base parameters that override the scene's and narval's defaults, and a style (marker shape and
-# colour in plots and legends). Order: the order measured and reported.
+# named base parameters that override the scene's (only where the method's base differs from what
+# narval resolves), and a style (marker shape and colour in plots and legends). Order: the order
+# measured and reported.
 METHODS = {
     "pathtrace": {"algorithm": "pathtrace", "settings": {}, "base": {}, "style": ("circle", "#1f77b4")},
     "raymarch-none": {"algorithm": "raymarch", "settings": {"multipleScattering": "none", "octaves": 1},
@@ -111,30 +82,25 @@ METHODS = {
     "raymarch-octaves": {"algorithm": "raymarch", "settings": {"multipleScattering": "octaves"},
                          "base": {"octaves": 4}, "style": ("diamond", "#a6761d")},
     "raymarch-cache": {"algorithm": "raymarch", "settings": {"multipleScattering": "cache", "octaves": 1},
-                       "base": {"msCache.resolution": 16, "msCache.paths": 256},
-                       "style": ("triangle-down", "#e7298a")},
+                       "base": {}, "style": ("triangle-down", "#e7298a")},
     "raymarch-cache-camera": {"algorithm": "raymarch",
                               "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.closure": "camera"},
-                              "base": {"msCache.resolution": 16, "msCache.paths": 256},
-                              "style": ("square", "#66a61e")},
+                              "base": {}, "style": ("square", "#66a61e")},
     "raymarch-cache-view": {"algorithm": "raymarch",
                             "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.layout": "view",
                                          "areaLightPhase": "exact"},
-                            "base": {"msCache.tile": 4, "msCache.slices": 8, "msCache.paths": 256,
-                                     "shadowWeighting": "phase"},
-                            "style": ("diamond", "#e6ab02")},
+                            "base": {"shadowWeighting": "phase"}, "style": ("diamond", "#e6ab02")},
     "raymarch-cache-direct": {"algorithm": "raymarch",
                               "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.layout": "view",
                                            "msCache.direct": True},
-                              "base": {"msCache.tile": 2, "msCache.slices": 8, "msCache.paths": 256},
-                              "style": ("triangle-down", "#666666")},
+                              "base": {"msCache.tile": 2}, "style": ("triangle-down", "#666666")},
     "raymarch-cache-filtered": {"algorithm": "raymarch",
                                 "settings": {"multipleScattering": "cache", "octaves": 1, "msCache.layout": "view",
                                              "msCache.direct": True, "msCache.tile": 1},
                                 "base": {"msCache.paths": 160, "msCache.filter": 1, "msCache.filterTolerance": 2},
                                 "style": ("circle", "#e41a1c")},
     "lobe-eq7": {"algorithm": "lobe", "settings": {"variant": "eq7"}, "base": {}, "style": ("triangle", "#1b9e77")},
-    "lobe-corrected": {"algorithm": "lobe", "settings": {"variant": "corrected"}, "base": {"viewSteps": 16},
+    "lobe-corrected": {"algorithm": "lobe", "settings": {"variant": "corrected"}, "base": {},
                        "style": ("cross", "#7570b3")},
 }
 
@@ -170,21 +136,6 @@ QUICK_SWEEPS = {
     "lobe-eq7": {"lobePoints": [10, 30], "depthFactor": [5, 100], "shadowSteps": [25, 100]},
     "lobe-corrected": {"lobePoints": [10, 30], "lobeRadius": [0.3, 3], "viewSteps": [8, 16]},
 }
-# narval's defaults when the scene does not set renderer.raymarch / renderer.lobe (README,
-# host/scene/scene_load.cpp); dotted names are nested objects (renderer.raymarch.msCache.resolution).
-REALTIME_DEFAULTS = {
-    "raymarch": {"steps": 60, "shadowSteps": 10, "octaves": 1, "msCache.resolution": 16, "msCache.paths": 256,
-                 "shadowAreaSamples": 4, "areaLightSamples": 1, "areaLightPhase": "points", "msCache.closure": "linear",
-                 "msCache.interpolation": "geometric", "msCache.layout": "grid", "msCache.tile": 4,
-                 "msCache.slices": 8, "shadowWeighting": "area", "msCache.filter": 0,
-                 "msCache.filterTolerance": 1, "msCache.filterTwicing": False},
-    "lobe": {"lobePoints": 30, "depthFactor": 20, "shadowSteps": 100, "lobeRadius": 1, "viewSteps": 24,
-             "areaLightPhase": "points"},
-}
-
-
-class NarvalError(Exception):
-    """A narval command failed; the message carries the command and its stderr."""
 
 
 # ---------------------------------------------------------------------------------------------
@@ -244,11 +195,8 @@ def parse_args(argv):
         usage_error("--reference-bounces wants a non-negative integer")
     if args.out is None:
         args.out = str(REPO / "build" / "speed_vs_error")
-    if not args.scenes:
-        args.scenes = [str(REPO / s) for s in DEFAULT_SCENES]
-        args.default_scenes = True
-    else:
-        args.default_scenes = False
+    args.default_scenes = not args.scenes
+    args.scenes = args.scenes or [str(REPO / s) for s in DEFAULT_SCENES]
     try:
         args.methods = parse_methods(args.methods)
         args.sweeps = build_sweeps(args.quick, args.methods, args.sweep)
@@ -304,7 +252,7 @@ def build_sweeps(quick, methods, overrides):
         if method in METHODS and method not in sweeps:
             raise ValueError("--sweep %s: method %s is not among --methods (%s)" % (item, method, ", ".join(methods)))
         if method not in sweeps or parameter not in sweeps[method]:
-            known = ", ".join("%s.%s" % (a, q) for a in sweeps for q in sweeps[a])
+            known = ", ".join("%s.%s" % (a, q) for a, s in sweeps.items() for q in s)
             raise ValueError("--sweep: unknown parameter %s.%s (known: %s)" % (method, parameter, known))
         try:
             sweeps[method][parameter] = [parse_number(v) for v in values.split(",")]
@@ -319,85 +267,38 @@ def format_value(value):
 
 
 # ---------------------------------------------------------------------------------------------
-# Scenes
+# Scenes and narval
 # ---------------------------------------------------------------------------------------------
 
-def display_transform(renderer):
-    """The scene's display (exposure, tone mapping) as `narval compare` options.
-
-    narval's PNG applies renderer.exposure (default 0) and renderer.toneMapping (true = aces,
-    false = none, or a name; default true), so ΔE is measured on what the PNG shows."""
-    exposure = renderer.get("exposure", 0)
-    tone = renderer.get("toneMapping", True)
-    if tone is True:
-        tone = "aces"
-    elif tone is False:
-        tone = "none"
-    options = ["--tonemap", str(tone)]
-    if exposure:
-        options += ["--exposure", str(exposure)]
-    return {"exposure": exposure, "tonemap": str(tone), "options": options}
-
-
-def nested_value(data, dotted, default):
-    """data["msCache"]["resolution"] for 'msCache.resolution', or default where a level is absent."""
-    for key in dotted.split("."):
-        if not isinstance(data, dict) or key not in data:
-            return default
-        data = data[key]
-    return data
-
-
-def load_scene(path):
-    """What the report needs from a scene file, or a 'skip' reason when it cannot be rendered."""
-    scene = {"path": str(Path(path).resolve()), "name": Path(path).stem, "skip": None}
+def load_scene(path, settings):
+    """What the report needs from a scene file (its bytes and volume files key the reference cache;
+    its bounces are narval's resolved value), or a 'skip' reason when it cannot be rendered."""
+    scene = {"path": str(Path(path).resolve()), "name": Path(path).stem, "skip": None, "volumes": []}
     with open(path, "rb") as f:
         scene["bytes"] = f.read()
     data = json.loads(scene["bytes"])
-    renderer = data.get("renderer", {})
-    scene["bounces"] = renderer.get("bounces", 3)
-    scene["display"] = display_transform(renderer)
-    scene["realtime_defaults"] = {
-        algorithm: {k: nested_value(renderer.get(algorithm, {}), k, v) for k, v in defaults.items()}
-        for algorithm, defaults in REALTIME_DEFAULTS.items()
-    }
-    scene["volumes"] = []
     for material in data.get("materials", []):
         if material.get("type") != "volume" or "path" not in material:
             continue
         try:
-            volume = Path(expand_environment(material["path"]))
+            volume = volume_path(scene["path"], material["path"])
         except ValueError as e:
             scene["skip"] = "volume path of material %s: %s" % (material.get("name"), e)
             continue
-        if not volume.is_absolute():
-            volume = Path(scene["path"]).parent / volume
-        volume = Path(os.path.normpath(volume))
         if not volume.is_file():
             scene["skip"] = "volume file %s is absent (set NARVAL_DATA_DIR)" % volume
             continue
         stat = volume.stat()
         scene["volumes"].append({"path": str(volume), "size": stat.st_size, "mtime_ns": stat.st_mtime_ns})
+    if not scene["skip"]:
+        scene["bounces"] = resolved_scene(settings.narval, scene["path"])["renderer"]["bounces"]
     return scene
-
-
-# ---------------------------------------------------------------------------------------------
-# Running narval
-# ---------------------------------------------------------------------------------------------
-
-def run_narval(settings, arguments):
-    """Runs narval with the arguments; returns stdout; raises NarvalError with stderr on failure."""
-    command = [settings.narval] + [str(a) for a in arguments]
-    result = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if result.returncode != 0:
-        raise NarvalError("%s (exit %d): %s" % (" ".join(command), result.returncode, result.stderr.strip()))
-    return result.stdout
 
 
 def narval_version(settings):
     """The version string. Not the binary's hash: every commit rebuilds it, and a converged reference
     costs tens of minutes on 2 cores; the path tracer's pixels are pinned by its golden tests."""
-    return run_narval(settings, ["--version"]).strip()
+    return run_narval(settings.narval, ["--version"]).strip()
 
 
 def device_options(settings):
@@ -405,42 +306,30 @@ def device_options(settings):
 
 
 def describe_device(settings, name):
-    """The `narval devices` row of the device called name (from a render's stats), as
-    'NAME (TYPE, PLATFORM DRIVER, N CUs, MEMORY)'; with no name, the row --device picks (index or
-    name substring; the first row without --device). Falls back to name, else '?'."""
+    """The `narval devices --json` entry of the device called name (from a render's stats), else the
+    one --device picks (index or name substring; the first without --device), as 'NAME (TYPE,
+    PLATFORM DRIVER, N CUs, MEMORY)'. Falls back to name, else '?'."""
     try:
-        lines = [line for line in run_narval(settings, ["devices"]).splitlines() if line.strip()]
+        devices = run_json(settings.narval, ["devices", "--json"])
     except NarvalError:
         return name or "?"
-    header = re.split(r"\s{2,}", lines[0].strip()) if lines else []
-    rows = []
-    for line in lines[1:]:
-        cells = re.split(r"\s{2,}", line.strip())
-        if len(cells) == len(header):
-            rows.append(dict(zip(header, cells)))
-    chosen = None
-    for row in rows:
-        if name:
-            if row.get("name") == name:
-                chosen = row
-        elif settings.device is None or settings.device == row.get("#", "") or (
-                not settings.device.isdigit() and settings.device.lower() in row.get("name", "").lower()):
-            chosen = row
-        if chosen:
-            break
-    if not chosen:
-        return name or "?"
-    return "%s (%s, %s %s, %s CUs, %s)" % (chosen.get("name"), chosen.get("type"), chosen.get("platform"),
-                                           chosen.get("driver"), chosen.get("CUs"), chosen.get("global mem"))
+    wanted = (settings.device or "").lower()
+    for d in devices:
+        if (d["name"] == name if name else
+                not wanted or wanted == str(d["index"]) or (not wanted.isdigit() and wanted in d["name"].lower())):
+            return "%s (%s, %s %s, %d CUs, %.0f GiB)" % (d["name"], d["type"], d["platform"], d["driver_version"],
+                                                         d["compute_units"], d["global_mem_bytes"] / 2 ** 30)
+    return name or "?"
+
+
+def method_sets(method):
+    """A method's fixed settings as --set PATH=VALUE strings; values JSON-encoded (strings quoted)."""
+    algorithm = METHODS[method]["algorithm"]
+    return ["renderer.%s.%s=%s" % (algorithm, k, json.dumps(v)) for k, v in METHODS[method]["settings"].items()]
 
 
 def method_settings_arguments(method):
-    """--set options for a method's fixed settings; values JSON-encoded (strings quoted)."""
-    algorithm = METHODS[method]["algorithm"]
-    options = []
-    for key, value in METHODS[method]["settings"].items():
-        options += ["--set", "renderer.%s.%s=%s" % (algorithm, key, json.dumps(value))]
-    return options
+    return [a for s in method_sets(method) for a in ("--set", s)]
 
 
 def warm_up(settings, scene, method):
@@ -452,8 +341,18 @@ def warm_up(settings, scene, method):
     if METHODS[method]["settings"].get("multipleScattering") == "cache":
         arguments += ["--set", "renderer.raymarch.msCache.resolution=1", "--set", "renderer.raymarch.msCache.paths=1"]
     with tempfile.TemporaryDirectory(prefix="speed_vs_error_") as scratch:
-        run_narval(settings, ["render", scene["path"], "-o", Path(scratch) / "warm_up.exr"] + arguments
+        run_narval(settings.narval, ["render", scene["path"], "-o", Path(scratch) / "warm_up.exr"] + arguments
                    + device_options(settings))
+
+
+def compare(settings, reference_exr, test_exr, *options):
+    """`narval compare REFERENCE TEST --json` under the display transform both EXRs record (the
+    scene's, as its PNG shows it); an error when they record none in common."""
+    result = run_json(settings.narval, ["compare", reference_exr, test_exr, "--json"] + list(options))
+    if result["display_transform"] != "as both EXRs record it":
+        raise NarvalError("compare %s %s: display transform %s, not the scene's (--refresh-reference renders the "
+                          "reference again)" % (reference_exr, test_exr, result["display_transform"]))
+    return result
 
 
 # ---------------------------------------------------------------------------------------------
@@ -465,9 +364,7 @@ def cache_root():
     base = os.environ.get("NARVAL_CACHE_DIR")
     if base == "off":
         return None
-    if not base:
-        base = str(Path.home() / ".cache" / "narval")
-    return Path(base) / "speed_vs_error"
+    return Path(base or Path.home() / ".cache" / "narval") / "speed_vs_error"
 
 
 def reference_key(scene, settings, bounces, version):
@@ -492,72 +389,55 @@ def render_reference(settings, scene, bounces, folder):
     its samples are counter-based); returns its stats, seconds summed over both runs. The snapshot
     lets `compare --reference-snapshot` estimate the reference's own noise floor."""
     folder.mkdir(parents=True, exist_ok=True)
-    common = ["--algorithm", "pathtrace", "--bounces", bounces, "--resolution", settings.resolution,
-              "--seed", REFERENCE_SEED] + device_options(settings)
+    common = ["render", scene["path"], "-o", folder / "reference.exr", "--algorithm", "pathtrace", "--bounces",
+              bounces, "--resolution", settings.resolution, "--seed", REFERENCE_SEED,
+              "--stats-json", folder / "stats.json"] + device_options(settings)
     snapshot_spp = max(1, settings.reference_spp // 4)
-    run_narval(settings, ["render", scene["path"], "-o", folder / "reference.exr", "--spp", snapshot_spp,
-                          "--stats-json", folder / "stats.json"] + common)
-    with open(folder / "stats.json") as f:
-        seconds = json.load(f)["seconds"]
+    run_narval(settings.narval, common + ["--spp", snapshot_spp])
+    stats = json.loads((folder / "stats.json").read_text())
     if settings.reference_spp > snapshot_spp:
+        seconds = stats["seconds"]
         shutil.copyfile(folder / "reference.exr", folder / "snapshot.exr")
-        run_narval(settings, ["render", scene["path"], "-o", folder / "reference.exr", "--spp",
-                              settings.reference_spp, "--resume", "--stats-json", folder / "stats.json"] + common)
-    with open(folder / "stats.json") as f:
-        stats = json.load(f)
-    if settings.reference_spp > snapshot_spp:
+        run_narval(settings.narval, common + ["--spp", settings.reference_spp, "--resume"])
+        stats = json.loads((folder / "stats.json").read_text())
         stats["seconds"] += seconds
-        with open(folder / "stats.json", "w") as f:
-            json.dump(stats, f)
+        (folder / "stats.json").write_text(json.dumps(stats))
     return stats
 
 
-def reference_noise(settings, scene, reference_exr, snapshot_exr):
-    """What the reference's own noise alone reads (compare --reference-snapshot): the JND% and mean
-    ΔE76 a noise-free image would have against it; None when it has no snapshot."""
-    if not Path(snapshot_exr).is_file():
-        return None
-    output = run_narval(settings, ["compare", reference_exr, reference_exr, "--reference-snapshot", snapshot_exr,
-                                   "--json"] + scene["display"]["options"])
-    return json.loads(output)["reference_noise"]
-
-
 def ensure_reference(settings, scene, version, scene_out):
-    """The reference for this scene in scene_out (reference.exr/.png), from the cache when possible."""
+    """The reference for this scene in scene_out (reference.exr/.png), from the cache when possible;
+    sets scene["display"] (exposure, tone mapping) from what `narval compare` applies to it."""
     bounces = settings.reference_bounces if settings.reference_bounces is not None else scene["bounces"]
     key, description = reference_key(scene, settings, bounces, version)
     root = cache_root()
-    cached = root / key[:24] if root else None
-    from_cache = bool(cached and (cached / "reference.exr").is_file() and (cached / "stats.json").is_file()
-                      and not settings.refresh_reference)
+    cached = root / key[:24] if root else scene_out / "reference_render"
+    # key.json is written last: a folder without it holds an unfinished render.
+    from_cache = bool(root and (cached / "key.json").is_file() and not settings.refresh_reference)
     if from_cache:
         print("  reference: cached (%s)" % cached, flush=True)
     else:
         print("  reference: pathtrace %d spp, %d bounces, %s ..." % (settings.reference_spp, bounces,
                                                                     settings.resolution), flush=True)
-        if cached:
-            staging = root / (key[:24] + ".partial")
-            shutil.rmtree(staging, ignore_errors=True)
-            render_reference(settings, scene, bounces, staging)
-            with open(staging / "key.json", "w") as f:
-                json.dump(description, f, indent=2, sort_keys=True)
-            shutil.rmtree(cached, ignore_errors=True)
-            staging.rename(cached)
-        else:
-            render_reference(settings, scene, bounces, scene_out / "reference_render")
-            cached = scene_out / "reference_render"
-    with open(cached / "stats.json") as f:
-        stats = json.load(f)
+        shutil.rmtree(cached, ignore_errors=True)
+        render_reference(settings, scene, bounces, cached)
+        (cached / "key.json").write_text(json.dumps(description, indent=2, sort_keys=True))
+    stats = json.loads((cached / "stats.json").read_text())
     for name in ("reference.exr", "reference.png", "snapshot.exr"):
         if (cached / name).is_file():
             shutil.copyfile(cached / name, scene_out / name)
     if not from_cache:
         print("  reference: %.1f s" % stats["seconds"], flush=True)
-    noise = reference_noise(settings, scene, scene_out / "reference.exr", scene_out / "snapshot.exr")
+    # The reference against itself: the display transform compare applies, and with the snapshot
+    # what the reference's own noise alone reads (the JND% and mean ΔE76 a noise-free image would have).
+    exr, snapshot = scene_out / "reference.exr", scene_out / "snapshot.exr"
+    own = compare(settings, exr, exr, *(["--reference-snapshot", snapshot] if snapshot.is_file() else []))
+    scene["display"] = {"exposure": own["exposure"], "tonemap": own["tonemap"]}
+    noise = own.get("reference_noise")
     if noise:
         print("  reference noise alone: JND %.2f%% (from its first %d samples)" % (noise["jnd76_pct"],
                                                                                  noise["snapshot_spp"]), flush=True)
-    return {"exr": scene_out / "reference.exr", "png": "reference.png", "spp": settings.reference_spp,
+    return {"exr": exr, "png": "reference.png", "spp": settings.reference_spp,
             "bounces": bounces, "seed": REFERENCE_SEED, "seconds": stats["seconds"], "device": stats["device"],
             "cached": from_cache, "key": key, "cache_folder": str(cached), "noise": noise}
 
@@ -566,18 +446,23 @@ def ensure_reference(settings, scene, version, scene_out):
 # Configurations
 # ---------------------------------------------------------------------------------------------
 
-def base_parameters(scene, settings, method):
+def base_parameters(settings, scene, method):
     """The values a method's parameters keep while another one varies: pathtrace at --base-spp and
-    the scene's bounces; a real-time method's named base (METHODS), else the scene's value, else
-    narval's default, for every parameter it sweeps."""
+    the scene's bounces; a real-time method's named base (METHODS), else the value narval resolves
+    for the scene with the method's settings applied (the scene's, else the loader's default)."""
     if METHODS[method]["algorithm"] == "pathtrace":
         return {"spp": settings.base_spp, "bounces": scene["bounces"]}
-    defaults = scene["realtime_defaults"][METHODS[method]["algorithm"]]
+    algorithm = METHODS[method]["algorithm"]
+    resolved = resolved_scene(settings.narval, scene["path"],
+                              ["renderer.algorithm=%s" % json.dumps(algorithm)] + method_sets(method))
     base = {}
     for parameter in settings.sweeps[method]:
-        base[parameter] = METHODS[method]["base"].get(parameter, defaults.get(parameter))
-        if base[parameter] is None:
-            raise ValueError("no default for %s.%s" % (method, parameter))
+        try:
+            base[parameter] = METHODS[method]["base"].get(parameter, value_at(resolved["renderer"][algorithm],
+                                                                              parameter))
+        except KeyError:
+            raise NarvalError("narval scene --resolved has no renderer.%s.%s (method %s)" % (algorithm, parameter,
+                                                                                            method))
     return base
 
 
@@ -599,15 +484,14 @@ def render_arguments(method, parameters):
     return options
 
 
-def build_configurations(scene, settings):
+def build_configurations(settings, bases):
     """One entry per (method, parameter, value); entries with equal parameters share one render."""
     configurations = []
     for method in settings.methods:
-        base = base_parameters(scene, settings, method)
+        base = bases[method]
         for parameter, values in settings.sweeps[method].items():
             for value in values:
-                parameters = dict(base)
-                parameters[parameter] = value
+                parameters = dict(base, **{parameter: value})
                 configurations.append({
                     "method": method,
                     "algorithm": METHODS[method]["algorithm"],
@@ -623,7 +507,7 @@ def build_configurations(scene, settings):
 def render_configuration(settings, scene, configuration, renders):
     """Renders one configuration into renders/ID.exr (+ .png); returns (seconds, build seconds or None,
     stats): pathtrace's time per image, else the median kernel time of --frames frames; the build
-    is the multiple-scattering cache's (raymarch-cache only), which is not in the frame time."""
+    is the multiple-scattering cache's (cache methods only), which is not in the frame time."""
     method = configuration["method"]
     exr = renders / (configuration["id"] + ".exr")
     stats_path = renders / (configuration["id"] + ".json")
@@ -632,9 +516,8 @@ def render_configuration(settings, scene, configuration, renders):
     arguments += render_arguments(method, configuration["parameters"])
     if configuration["algorithm"] != "pathtrace":
         arguments += ["--frames", settings.frames]
-    run_narval(settings, arguments)
-    with open(stats_path) as f:
-        stats = json.load(f)
+    run_narval(settings.narval, arguments)
+    stats = json.loads(stats_path.read_text())
     if configuration["algorithm"] == "pathtrace":
         return stats["seconds"], None, stats
     build = None
@@ -643,13 +526,7 @@ def render_configuration(settings, scene, configuration, renders):
     return stats["ms_per_frame"]["median"] / 1000.0, build, stats
 
 
-def compare_images(settings, scene, reference_exr, test_exr):
-    """narval compare under the scene's display transform; returns its JSON."""
-    output = run_narval(settings, ["compare", reference_exr, test_exr, "--json"] + scene["display"]["options"])
-    return json.loads(output)
-
-
-def measure_scene(settings, scene, reference, scene_out):
+def measure_scene(settings, scene, reference, scene_out, bases):
     """Renders and compares every configuration; returns (result rows, one per configuration entry;
     the device name the renders report)."""
     renders = scene_out / "renders"
@@ -658,7 +535,7 @@ def measure_scene(settings, scene, reference, scene_out):
     rows = []
     warmed = set()
     device = None
-    for configuration in build_configurations(scene, settings):
+    for configuration in build_configurations(settings, bases):
         method = configuration["method"]
         if method not in warmed:
             warm_up(settings, scene, method)
@@ -667,7 +544,7 @@ def measure_scene(settings, scene, reference, scene_out):
             seconds, build, stats = render_configuration(settings, scene, configuration, renders)
             device = device or stats.get("device")
             light = stats.get("light_cache_ms") / 1000.0 if stats.get("light_cache_ms") is not None else None
-            comparison = compare_images(settings, scene, reference["exr"], renders / (configuration["id"] + ".exr"))
+            comparison = compare(settings, reference["exr"], renders / (configuration["id"] + ".exr"))
             measured[configuration["id"]] = (seconds, build, light, comparison)
             note = ""
         else:
@@ -1281,8 +1158,8 @@ def select_scenes(settings):
             print("speed_vs_error.py: scene %s not found" % path, file=sys.stderr)
             sys.exit(2)
         try:
-            scenes.append(load_scene(path))
-        except (OSError, ValueError) as e:
+            scenes.append(load_scene(path, settings))
+        except (OSError, ValueError, NarvalError) as e:
             print("speed_vs_error.py: cannot read scene %s: %s" % (path, e), file=sys.stderr)
             sys.exit(2)
     return scenes
@@ -1313,13 +1190,13 @@ def run(settings):
         reference = ensure_reference(settings, scene, version, scene_out)
         if settings.references_only:
             continue
-        rows, render_device = measure_scene(settings, scene, reference, scene_out)
+        bases = {m: base_parameters(settings, scene, m) for m in settings.methods}
+        rows, render_device = measure_scene(settings, scene, reference, scene_out, bases)
         device = device or render_device or reference["device"]
-        bases = {m: base_parameters(scene, settings, m) for m in settings.methods}
         report.update(reference=reference, rows=rows, bases=bases, summary=summarise(rows, settings.jnd_threshold),
                       budget_picks=budget_picks(rows, settings.budgets_ms, settings.jnd_threshold),
                       plots=write_plots(out, scene["name"], rows, settings, reference))
-        entry.update(display={k: scene["display"][k] for k in ("exposure", "tonemap")},
+        entry.update(display=scene["display"],
                      volumes=scene["volumes"],
                      reference={k: (str(v) if isinstance(v, Path) else v) for k, v in reference.items()},
                      base_parameters=bases, summary=report["summary"], budget_picks=report["budget_picks"],

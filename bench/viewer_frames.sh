@@ -16,20 +16,11 @@ cd "$(dirname "$0")/.."
 narval=${NARVAL:-build/narval}
 scenes=$(ls scenes/*.json)
 algorithms="raymarch lobe pathtrace"
-target=50
+target_ms=50
 device=""
 out=build/viewer_frames
-while [ $# -gt 0 ]; do
-  case $1 in
-    --scenes) scenes=$2; shift 2 ;;
-    --algorithms) algorithms=$2; shift 2 ;;
-    --target-ms) target=$2; shift 2 ;;
-    --device) device="--device $2"; shift 2 ;;
-    --out) out=$2; shift 2 ;;
-    *) echo "viewer_frames.sh: unknown option $1" >&2; exit 2 ;;
-  esac
-done
-source bench/bench_common.sh
+. bench/bench_common.sh
+bench_options "scenes algorithms target_ms device out" "$@"
 bench_init
 command -v xvfb-run > /dev/null || { echo "viewer_frames.sh: xvfb-run missing (scripts/setup.sh installs it)" >&2; exit 2; }
 mkdir -p "$out"
@@ -41,7 +32,7 @@ mkdir -p "$out"
 
 report="$out/report.md"
 {
-  echo "$(date -u +%F) · \`$cmdline\` · target $target ms"
+  echo "$(date -u +%F) · \`$cmdline\` · target $target_ms ms"
   echo
   echo "| scene | algorithm | still: size, kernel / frame ms | moving: size, kernel / frame ms | present ms | device |"
   echo "|---|---|---|---|---|---|"
@@ -53,7 +44,7 @@ for scene in $scenes; do
     echo "viewer_frames: $name $algorithm" >&2
     # The path tracer's still frames add a sample each (4 at most); the real-time ones redraw.
     if ! xvfb-run -a -s '-screen 0 1600x1200x24' "$narval" view "$scene" --algorithm "$algorithm" $device \
-        --set renderer.spp=4 --script "$out/orbit.txt" --target-ms "$target" --stats-json "$stats" \
+        --set renderer.spp=4 --script "$out/orbit.txt" --target-ms "$target_ms" --stats-json "$stats" \
         > "$out/${name}_${algorithm}.log" 2>&1; then
       echo "| $name | $algorithm | failed: $(tail -1 "$out/${name}_${algorithm}.log") | | | |" >> "$report"
       continue

@@ -38,10 +38,13 @@ view() {  # view TILE PATHS STEPS [FILTER TOLERANCE TWICING GUIDE ALLOCATION]: t
   echo --algorithm raymarch --set 'renderer.raymarch.multipleScattering="cache"' \
     --set 'renderer.raymarch.msCache.layout="view"' --set renderer.raymarch.msCache.direct=true \
     --set renderer.raymarch.msCache.tile="$1" --set renderer.raymarch.msCache.paths=$((($2 + SCALE_PATHS - 1) / SCALE_PATHS)) \
-    --set renderer.raymarch.steps="$3" --set renderer.raymarch.msCache.filter="${4:-0}" \
-    --set renderer.raymarch.msCache.filterTolerance="${5:-1}" \
-    --set renderer.raymarch.msCache.filterTwicing="${6:-false}" --set renderer.raymarch.msCache.guide="${7:-0}" \
-    --set renderer.raymarch.msCache.allocation="\"${8:-even}\""
+    --set renderer.raymarch.steps="$3"
+  shift 3  # the optional keys are set only where given (not "-"): else the scene's as narval resolves it
+  for k in filter filterTolerance filterTwicing guide allocation; do
+    [ $# -gt 0 ] || break
+    [ "$1" = - ] || echo --set "renderer.raymarch.msCache.$k=$([ $k = allocation ] && echo "\"$1\"" || echo "$1")"
+    shift
+  done
 }
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null
 "$N" devices
@@ -68,16 +71,16 @@ hd_configs=(
   "disney_cloud_front front_t8_p160_f2_k0.5 8 160 30 2 0.5"
   # The 320x240 picks of the Disney scenes (README), twiced and allocated (back-lit) and guided
   # (front-lit), at 4x the tile, and with fewer paths for a 100 ms build.
-  "disney_cloud back_t4_p136_f1.5_k2_twiced_perceptual 4 136 30 1.5 2 true 0 perceptual"
-  "disney_cloud back_t4_p48_f1.5_k2_twiced_perceptual 4 48 30 1.5 2 true 0 perceptual"
-  "disney_cloud_front front_t8_p480_f2_k0.5_g0.15 8 480 30 2 0.5 false 0.15"
-  "disney_cloud_front front_t8_p160_f2_k0.5_g0.15 8 160 30 2 0.5 false 0.15"
+  "disney_cloud back_t4_p136_f1.5_k2_twiced_perceptual 4 136 30 1.5 2 true - perceptual"
+  "disney_cloud back_t4_p48_f1.5_k2_twiced_perceptual 4 48 30 1.5 2 true - perceptual"
+  "disney_cloud_front front_t8_p480_f2_k0.5_g0.15 8 480 30 2 0.5 - 0.15"
+  "disney_cloud_front front_t8_p160_f2_k0.5_g0.15 8 160 30 2 0.5 - 0.15"
 )
 stage 1 && stamp "1. real-time picks at $HD_RES"
 stage 1 && for c in "${hd_configs[@]}"; do
   set -- $c
   run render "$(sc $1)" -o "$out/hd/$2.exr" --resolution "$HD_RES" --frames 20 \
-    $(view $3 $4 $5 ${6:-0} ${7:-1} ${8:-false} ${9:-0} ${10:-even}) \
+    $(view "${@:3}") \
     --stats-json "$out/hd/$2.json" | grep -v '^wrote'
 done
 stage 2 && stamp "2. 320x240 references at $REF_SPP spp"
@@ -91,15 +94,15 @@ stage 3 && stamp "3. 320x240 caches with many paths"
 lo_configs=(
   "disney_cloud back_t2_p8192 2 8192"
   "disney_cloud back_t1_p4096 1 4096"
-  "disney_cloud back_t1_p136_f1.5_k2_twiced_perceptual 1 136 1.5 2 true 0 perceptual"
-  "disney_cloud_front front_t2_p480_f2_k0.5_g0.15 2 480 2 0.5 false 0.15"
+  "disney_cloud back_t1_p136_f1.5_k2_twiced_perceptual 1 136 1.5 2 true - perceptual"
+  "disney_cloud_front front_t2_p480_f2_k0.5_g0.15 2 480 2 0.5 - 0.15"
   "disney_cloud_front front_t3_p16384 3 16384"
   "disney_cloud_front front_t2_p8192 2 8192"
 )
 stage 3 && for c in "${lo_configs[@]}"; do
   set -- $c
   run render "$(sc $1)" -o "$out/img/$2.exr" --resolution 320x240 --frames 3 --seed 1 \
-    $(view $3 $4 30 ${5:-0} ${6:-1} ${7:-false} ${8:-0} ${9:-even}) \
+    $(view $3 $4 30 "${@:5}") \
     --stats-json "$out/img/$2.json" | grep -v '^wrote'
 done
 (stage 2 || stage 3) && (cd "$out/img" && tar -cf "$out/images.tar" ./*.exr ./*.json)

@@ -19,6 +19,7 @@ done
 strip --strip-unneeded .devrun/lib/* 2>/dev/null || true
 tar -C .devrun -cJf .devrun/lib.tar.xz lib && rm -rf .devrun/lib
 echo libnvidia-opencl.so.1 >.devrun/icd/nvidia.icd
-data=${NARVAL_DATA_DIR:-../shared/data/volumes}
-for g in wdas_cloud_sixteenth.vdb openvdb_smoke1_v222.vdb; do [ -f "$data/$g" ] && cp "$data/$g" .devrun/data/; done
+for g in $(python3 bench/scene_env.py volumes scenes/disney_cloud.json; python3 bench/scene_env.py volumes scenes/smoke.json); do
+  [ -f "$g" ] && cp "$g" .devrun/data/
+done
 du -sh .devrun

@@ -24,14 +24,13 @@ import re
 import shlex
 import signal
 import struct
-import subprocess
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.dirname(HERE))  # bench/: what the bench scripts share
-from scene_env import expand_environment  # noqa: E402
+from scene_env import resolved_scene, run_narval, volume_path  # noqa: E402
 DEFAULT_VENV = os.path.join(REPO, "build", "mitsuba-venv")
 DEFAULT_NARVAL = os.path.join(REPO, "build", "narval")
 WORK_DIR = os.path.join(REPO, "build", "vs_mitsuba")
@@ -121,36 +120,8 @@ except ImportError:  # another interpreter: main() re-executes under the venv be
 
 
 # ================================================================================================
-# narval's scene file: the parts the path tracer uses (host/scene/scene_load.cpp, scene.h)
+# narval's scene, as `narval scene --resolved` writes it: every default the loader took filled in
 # ================================================================================================
-
-def vec3(obj, key, default):
-    v = obj.get(key, default)
-    return [float(x) for x in v]
-
-
-def apply_override(doc, spec):
-    """narval's --set PATH=VALUE (host/scene/json_override.cpp): a dotted path with array indices
-    (materials.1.g, materials[1].g); the value as JSON, else as a bare string."""
-    path, _, text = spec.partition("=")
-    try:
-        value = json.loads(text)
-    except ValueError:
-        value = text
-    parts = [p for p in re.split(r"\.|\[(\d+)\]", path) if p]
-    node = doc
-    for i, part in enumerate(parts):
-        last = i + 1 == len(parts)
-        if isinstance(node, list):
-            if last:
-                node[int(part)] = value
-            else:
-                node = node[int(part)]
-        elif last:
-            node[part] = value
-        else:
-            node = node.setdefault(part, {})
-
 
 def scene_overrides(narval_args):
     """The scene changes among narval render options: --set PATH=VALUE... and --bounces N, so the
@@ -173,51 +144,30 @@ def scene_overrides(narval_args):
     return out
 
 
-def load_narval_scene(path, resolution=None, overrides=()):
-    """The scene as narval reads it, with its defaults (host/scene/scene.h), as plain dicts;
-    `overrides` are --set PATH=VALUE strings applied first, as narval does."""
-    with open(path) as f:
-        doc = json.load(f)
-    for spec in overrides:
-        apply_override(doc, spec)
-    scene_dir = os.path.dirname(os.path.abspath(path))
+def load_narval_scene(narval, path, resolution=None, overrides=()):
+    """The parts of the scene the path tracer uses, as narval resolves it (`narval scene --resolved`,
+    `overrides` being --set PATH=VALUE strings), as plain dicts: materials by name (a volume's grid
+    path found as the loader finds it), primitives with their material, camera, size, bounces."""
+    sets = list(overrides) + (["renderer.resolution=[%d,%d]" % tuple(resolution)] if resolution else [])
+    doc = resolved_scene(narval, path, sets)
     materials = {}
-    for m in doc.get("materials", []):
-        mat = {"name": m["name"], "type": m["type"]}
-        if m["type"] == "emitter":
-            mat["albedo"] = vec3(m, "albedo", [0, 0, 0])
-        else:
-            mat["scattering"] = vec3(m, "scattering", [0, 0, 0])
-            mat["absorption"] = vec3(m, "absorption", [0, 0, 0])
-            mat["phase"] = m.get("phaseFunction", "isotropic")
-            g = float(m.get("g", 0.0))
+    for m in doc["materials"]:
+        mat = materials[m["name"]] = dict(m)
+        if m["type"] == "volume":
+            g = float(m["g"]) if m["phaseFunction"] == "hg" else 0.0
             mat["g"] = math.copysign(0.9999, g) if abs(g) == 1 else g  # narval clamps |g| = 1
-            mat["density"] = float(m.get("density", 1.0))
-            mat["grid"] = m.get("grid", "density")
-            mat["gridSpace"] = m.get("gridSpace", "unit")
-            mat["emission"] = m.get("emission")
-            mat["path"] = None
-            if "path" in m:
-                p = expand_environment(m["path"])
-                mat["path"] = os.path.normpath(p if os.path.isabs(p) else os.path.join(scene_dir, p))
-        materials[mat["name"]] = mat
-    prims = []
-    for p in doc.get("primitives", []):
-        t = p.get("transform", {})
-        prims.append({"name": p.get("name", ""), "type": p["type"], "material": materials[p["materialName"]],
-                      "position": vec3(t, "position", [0, 0, 0]), "scale": vec3(t, "scale", [1, 1, 1]),
-                      "rotation": vec3(t, "rotation", [0, 0, 0])})
-    cam = doc["camera"]
-    camera = {"position": vec3(cam, "position", [0, 0, -5]), "lookAt": vec3(cam, "lookAt", [0, 0, 0]),
-              "up": vec3(cam, "up", [0, 1, 0]), "vfov": float(cam.get("vfov", 45.0)),
-              "aperture": float(cam.get("aperture", 0.0)), "focus": float(cam.get("focus", 1.0))}
+            mat["path"] = str(volume_path(path, m["path"])) if "path" in m else None
+            mat["emission"], mat["density"] = m.get("emission"), float(m["density"])
+    floats = lambda obj: {k: [float(x) for x in v] if isinstance(v, list) else float(v) for k, v in obj.items()}
+    prims = [dict(floats(p["transform"]), name=p.get("name", ""), type=p["type"], material=materials[p["materialName"]])
+             for p in doc["primitives"]]
     r = doc["renderer"]
-    width, height = (int(r["resolution"][0]), int(r["resolution"][1])) if resolution is None else resolution
-    return {"path": os.path.abspath(path), "materials": materials, "primitives": prims, "camera": camera,
-            "width": width, "height": height, "spp": int(r.get("spp", 1000)), "bounces": int(r.get("bounces", 3)),
-            "background": vec3(doc, "background", [0, 0, 0])}
+    return {"path": os.path.abspath(path), "materials": materials, "primitives": prims, "camera": floats(doc["camera"]),
+            "width": r["resolution"][0], "height": r["resolution"][1], "spp": r["spp"], "bounces": r["bounces"],
+            "background": doc["background"]}
 
 
+# ================================================================================================
 # ================================================================================================
 # Grids, read as narval reads them (host/volume/vdb_io.cpp, vol_io.cpp)
 # ================================================================================================
@@ -384,7 +334,7 @@ def translate_volume(p, mat, out_dir):
     albedo = np.where(k > 0, sig_s / np.where(k > 0, k, 1), 0.0)
     grey = bool(np.all(sig_a == sig_a[0]) and np.all(sig_s == sig_s[0]))
     g = -mat["g"] if "hg_sign" in PERTURB else mat["g"]
-    phase = {"type": "hg", "g": g} if mat["phase"] == "hg" and g != 0 else {"type": "isotropic"}
+    phase = {"type": "hg", "g": g} if mat["phaseFunction"] == "hg" and g != 0 else {"type": "isotropic"}
     M = primitive_matrix(p)
     notes = []
     if mat["path"] is None:
@@ -542,14 +492,10 @@ def read_exr_rgb(path):
 def render_narval(narval, scene_path, spp, seed, resolution, out_exr, extra_args=(), stats=True):
     """narval render --algorithm pathtrace; returns (image HxWx3, stats dict)."""
     stats_path = out_exr[:-4] + ".stats.json"
-    cmd = [narval, "render", scene_path, "--algorithm", "pathtrace", "--spp", str(spp),
-           "--resolution", "%dx%d" % resolution, "--seed", str(seed), "-o", out_exr, "-q"]
-    if stats:
-        cmd += ["--stats-json", stats_path]
-    cmd += list(extra_args)
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        raise RuntimeError("narval failed (%d): %s\n%s" % (r.returncode, " ".join(cmd), r.stderr.strip()))
+    # A failure raises scene_env.NarvalError, a RuntimeError.
+    run_narval(narval, ["render", scene_path, "--algorithm", "pathtrace", "--spp", spp, "--resolution",
+                        "%dx%d" % resolution, "--seed", seed, "-o", out_exr, "-q"]
+               + (["--stats-json", stats_path] if stats else []) + list(extra_args))
     st = {}
     if stats:
         with open(stats_path) as f:
@@ -701,7 +647,7 @@ def scene_tag(path):
 
 
 def run_compare(scene_path, spp, seeds, resolution, narval, out_dir, narval_args=(), seed_offset=0, quiet=False):
-    scene = load_narval_scene(scene_path, resolution, scene_overrides(narval_args))
+    scene = load_narval_scene(narval, scene_path, resolution, scene_overrides(narval_args))
     res = (scene["width"], scene["height"])
     os.makedirs(out_dir, exist_ok=True)
     t0 = time.time()
@@ -799,7 +745,7 @@ def reference(scene_path, scene, res, ref_spp, narval, cache_dir):
 
 
 def run_race(args):
-    scene = load_narval_scene(args.scene, args.resolution)
+    scene = load_narval_scene(args.narval, args.scene, args.resolution)
     res = (scene["width"], scene["height"])
     ladder = [int(x) for x in args.ladder.split(",")]
     narval_args = shlex.split(args.narval_args or "")
@@ -1041,11 +987,11 @@ def main():
         write_picture(args.compare_dir, args.out, args.diff_scale)
         print("wrote %s" % args.out)
         return 0
-    if args.command != "translate" and not os.access(args.narval, os.X_OK):
+    if not os.access(args.narval, os.X_OK):
         print("vs_mitsuba: no narval binary at %s (--narval or $NARVAL_BINARY)" % args.narval, file=sys.stderr)
         return 2
     if args.command == "translate":
-        d, notes = translate_scene(load_narval_scene(args.scene), args.out_dir)
+        d, notes = translate_scene(load_narval_scene(args.narval, args.scene), args.out_dir)
         print("wrote %s" % os.path.join(args.out_dir, "mitsuba_scene.json"))
         for n in notes:
             print("note: " + n)
