@@ -14,11 +14,13 @@
 namespace narval {
 namespace {
 
+// The arguments' names do not depend on optimisation, which is most of a build's time
+// (-cl-opt-disable: these builds are never run).
 std::vector<std::string> deviceArgumentNames(ClRuntime& rt, const std::string& kernel, const std::string& options) {
   const cl::Program program = buildProgram(rt, kernel == "light_cache_build" ? "light_cache.cl"
                                                : kernel.rfind("ms_cache_", 0) == 0 ? "ms_cache.cl"
                                                                              : kernel + ".cl",
-                                           options + " -cl-kernel-arg-info");
+                                           options + " -cl-kernel-arg-info -cl-opt-disable");
   const cl::Kernel k(program, kernel.c_str());
   std::vector<std::string> names;
   const cl_uint count = k.getInfo<CL_KERNEL_NUM_ARGS>();
