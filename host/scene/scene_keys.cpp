@@ -35,9 +35,11 @@ json schemaScene(const json& renderer) {
     materials.back()["emission"] = e;
   }
   json primitives = json::array();
-#define LIGHT_KIND_PRIMITIVE(id, value, name, prefix, scaled, area, vkey, key, lo, hi, fallback) \
-  primitives.push_back({{"type", name}, {"materialName", "light"}});                            \
-  if (vkey) primitives.back()[vkey ? vkey : ""] = {0, -1, 0};
+  auto light = [&](const char* type, const char* vectorKey) {  // the kind's vector key is required
+    primitives.push_back({{"type", type}, {"materialName", "light"}});
+    if (vectorKey) primitives.back()[vectorKey] = {0, -1, 0};
+  };
+#define LIGHT_KIND_PRIMITIVE(id, value, name, prefix, scaled, area, vkey, key, lo, hi, fallback) light(name, vkey);
   LIGHT_KINDS(LIGHT_KIND_PRIMITIVE)
 #undef LIGHT_KIND_PRIMITIVE
   primitives.push_back({{"type", "volume"}, {"materialName", "isotropic"}});
