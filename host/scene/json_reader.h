@@ -28,7 +28,7 @@ struct KeyRecord {
   std::string range;  // "[0, 1]", ">= 1", the allowed names; "" any
   json fallback;      // the value taken when it is left out; null: required, or no value
   bool required = false;
-  const json* given = nullptr;  // the scene's value, if it gives one
+  const json* given = nullptr;  // the scene's value, if it gives one (valid while the scene is read)
 };
 
 // Where messages go while one scene is read.
@@ -44,11 +44,11 @@ struct JsonContext {
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
   void warn(const std::string& key, const std::string& what) const;
-  // Warns "KEY: what" when the scene sets the key to something other than its default: a setting
-  // that cannot apply is named, while a resolved scene (every default written out) stays quiet.
   // Whether the scene sets the key (or, for changedUnder, any key below it) away from its default.
   bool changed(const std::string& key) const;
   bool changedUnder(const std::string& key) const;
+  // Warns "KEY: what" when the key is changed: a setting that cannot apply is named, while a
+  // resolved scene (every default written out) stays quiet.
   void warnIfChanged(const std::string& key, const std::string& what) const;
 };
 
