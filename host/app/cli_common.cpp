@@ -10,7 +10,7 @@
 
 #include "core/atomic_file.h"
 #include "core/input_error.h"
-#include "scene/json_reader.h"
+#include "core/near_miss.h"
 
 namespace narval {
 
@@ -151,7 +151,7 @@ std::string unknownFlag(const CLI::App& app, int argc, char** argv) {
     std::string meant;
     for (const std::string& n : names) {
       if (n == bare) known = !singleDash, meant = n;
-      if (meant.empty() && (scene_detail::nearMiss(bare, n) || (bare.size() >= 3 && n.rfind(bare, 0) == 0))) meant = n;
+      if (meant.empty() && (nearMiss(bare, n) || (bare.size() >= 3 && n.rfind(bare, 0) == 0))) meant = n;
     }
     if (known || (!singleDash && arg.size() == 2)) continue;
     if (singleDash && sub)  // -q and other one-letter flags are the parser's; "-spp" is a typo

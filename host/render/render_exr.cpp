@@ -54,11 +54,15 @@ nlohmann::json renderSettings(const Scene& scene) {
   return doc;
 }
 
-std::string renderKey(const Scene& scene) {
+namespace {
+std::string keyOfSettings(const std::string& settings) {
   char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)fnv1a64(renderSettings(scene).dump()));
+  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)fnv1a64(settings));
   return hex;
 }
+}  // namespace
+
+std::string renderKey(const Scene& scene) { return keyOfSettings(renderSettings(scene).dump()); }
 
 namespace {
 
@@ -113,8 +117,8 @@ RenderIdentity renderIdentity(const Scene& scene) {
   RenderIdentity id;
   id.seed = scene.renderer.seed;
   id.scene = scene.sourcePath;
-  id.renderKey = renderKey(scene);
   id.settings = renderSettings(scene).dump();
+  id.renderKey = keyOfSettings(id.settings);
   id.exposure = scene.renderer.exposure;
   id.toneMapping = scene.renderer.toneMapping;
   id.overrides = scene.overrides;

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <limits>
 
+#include "core/near_miss.h"
 #include "core/number_format.h"
 
 namespace narval::scene_detail {
@@ -56,13 +57,6 @@ std::string schemaKey(const std::string& key) {
   return out;
 }
 
-namespace {
-std::string lowercase(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-}  // namespace
-
 // Other renderers' and papers' words for narval's keys (lower case): taken for the key as a typo is.
 const std::pair<const char*, const char*> kSynonyms[] = {
     {"samples", "spp"},        {"samplesperpixel", "spp"}, {"maxdepth", "bounces"},   {"maxbounces", "bounces"},
@@ -76,19 +70,6 @@ bool isTypoOf(const std::string& unknown, const std::string& name) {
     if (lowercase(unknown) == word && name == key) return true;
   return nearMiss(unknown, name) &&
          (std::max(unknown.size(), name.size()) >= 3 || lowercase(unknown) == lowercase(name));
-}
-
-bool nearMiss(const std::string& a, const std::string& b) {
-  std::string x = lowercase(a), y = lowercase(b);
-  if (x == y) return true;
-  if (x.size() > y.size()) std::swap(x, y);
-  if (y.size() - x.size() > 1) return false;
-  size_t i = 0;
-  while (i < x.size() && x[i] == y[i]) ++i;  // the first difference
-  if (x.size() < y.size()) return x.compare(i, std::string::npos, y, i + 1, std::string::npos) == 0;  // insertion
-  if (x.compare(i + 1, std::string::npos, y, i + 1, std::string::npos) == 0) return true;            // replacement
-  return i + 1 < x.size() && x[i] == y[i + 1] && x[i + 1] == y[i] &&                                 // swap
-         x.compare(i + 2, std::string::npos, y, i + 2, std::string::npos) == 0;
 }
 
 std::string formatNumber(float v) {

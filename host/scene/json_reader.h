@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -59,10 +58,7 @@ std::string childKey(const std::string& parent, const std::string& name);  // "a
 std::string indexKey(const std::string& parent, size_t index);             // "a" + 1 -> "a[1]"
 // A key as the scene-format reference names it: indices dropped, "materials[2].g" -> "materials[].g".
 std::string schemaKey(const std::string& key);
-// True when `a` and `b` differ only by letter case or by one edit (a letter inserted, deleted,
-// replaced, or two neighbours swapped), after case is ignored.
-bool nearMiss(const std::string& a, const std::string& b);
-// An unknown key that is taken for a typo of `name`: a near miss, by case at any length, by one
+// An unknown key that is taken for a typo of `name`: a near miss (core/near_miss.h), by case at any length, by one
 // edit when the longer of the two has three letters or more ("sp" for "spp"; "x" is not a misspelt
 // "g"), or another renderer's word for it ("samples" for "spp", "maxDepth" for "bounces").
 bool isTypoOf(const std::string& unknown, const std::string& name);

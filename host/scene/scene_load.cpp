@@ -5,7 +5,7 @@
 // tests/unit/scene_format_doc_test.cpp); scene.h holds the defaults.
 //
 // Unknown keys (anywhere, including keys of the other material type) are warnings, except a near
-// miss of a key the same object takes ("sPP" for "spp": json_reader.h, nearMiss), which fails, and
+// miss of a key the same object takes ("sPP" for "spp": core/near_miss.h), which fails, and
 // any unknown key under --set, where a key the loader does not know is a typo.
 #include <cmath>
 #include <cstring>
@@ -13,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <utility>
 

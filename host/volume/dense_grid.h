@@ -34,16 +34,15 @@ constexpr uint64_t kMaxDenseGridBytes = uint64_t(8) << 30;
 DenseGrid loadGrid(const std::string& path, const std::string& gridName = "density");
 // The lower-case extension of `path` (".vdb", ".vol", "" without one): how grid readers tell formats apart.
 std::string gridFileExtension(const std::string& path);
+// Reads in a forked child on Linux, as inspectVdb does (OpenVDB 10's reader aborts or corrupts memory
+// on some corrupt files; the child's death becomes an InputError); NARVAL_VDB_IN_PROCESS=1 reads
+// in-process (debuggers, memory checkers).
 DenseGrid loadVdb(const std::string& path, const std::string& gridName);
 DenseGrid loadVol(const std::string& path);
 // loadVol on a seekable stream at its start; `path` names it in messages and becomes DenseGrid::source.
 // Reads `chunkBytes` at a time (small ones test the boundaries); a token as long as a chunk is not a number.
 DenseGrid parseVol(std::istream& in, const std::string& path, size_t chunkBytes = size_t(1) << 20);
 
-// The float grids' names in a .vdb (error messages, `narval info`). It and loadVdb read in a forked child
-// on Linux (OpenVDB 10's reader aborts or corrupts memory on some corrupt files; the child's death becomes
-// an InputError); NARVAL_VDB_IN_PROCESS=1 reads in-process (debuggers, memory checkers).
-std::vector<std::string> vdbGridNames(const std::string& path);
 
 // Writes a FloatGrid named `gridName` (fog volume, zero background, zeros inactive, uniform voxel
 // size, index (0,0,0) at the origin), atomically (PATH.tmp, then renamed). Throws InputError when the

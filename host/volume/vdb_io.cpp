@@ -94,17 +94,12 @@ openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
   }
 }
 
-// The grids' names and types, in the file's order.
+// The grids' names and types, sorted by name so that a message does not depend on the writer's order.
 std::vector<GridEntry> listGrids(const openvdb::GridPtrVec& grids) {
   std::vector<GridEntry> out;
   for (const openvdb::GridBase::Ptr& g : grids) out.push_back({g->getName(), g->valueType(), g->isType<openvdb::FloatGrid>()});
+  std::sort(out.begin(), out.end(), [](const GridEntry& a, const GridEntry& b) { return a.name < b.name; });
   return out;
-}
-
-// Names listed in messages: sorted, so that a message does not depend on the writer's order.
-std::vector<GridEntry> sortedByName(std::vector<GridEntry> grids) {
-  std::sort(grids.begin(), grids.end(), [](const GridEntry& a, const GridEntry& b) { return a.name < b.name; });
-  return grids;
 }
 
 std::string describeGrids(const std::vector<GridEntry>& grids) {
@@ -118,7 +113,6 @@ std::string describeGrids(const std::vector<GridEntry>& grids) {
   return s;
 }
 
-
 std::string dimsString(int64_t x, int64_t y, int64_t z) {
   return std::to_string(x) + "x" + std::to_string(y) + "x" + std::to_string(z);
 }
@@ -127,13 +121,14 @@ std::string dimsString(int64_t x, int64_t y, int64_t z) {
 // file has otherwise.
 openvdb::FloatGrid::Ptr requireFloatGrid(const std::string& path, const std::string& gridName,
                                          const openvdb::GridPtrVec& all) {
+  for (const openvdb::GridBase::Ptr& g : all)
+    if (g->getName() == gridName && g->isType<openvdb::FloatGrid>()) return openvdb::gridPtrCast<openvdb::FloatGrid>(g);
   const std::vector<GridEntry> grids = listGrids(all);
   const auto entry = std::find_if(grids.begin(), grids.end(), [&](const GridEntry& g) { return g.name == gridName; });
   if (entry == grids.end())
-    throw inputError(path, "grid", "no grid named " + quoted(gridName) + " (" + describeGrids(sortedByName(grids)) + ")");
-  if (entry->isFloat) return openvdb::gridPtrCast<openvdb::FloatGrid>(all[size_t(entry - grids.begin())]);
+    throw inputError(path, "grid", "no grid named " + quoted(gridName) + " (" + describeGrids(grids) + ")");
   std::string floats;
-  for (const GridEntry& g : sortedByName(grids))
+  for (const GridEntry& g : grids)
     if (g.isFloat) floats += (floats.empty() ? "" : ", ") + g.name;
   throw inputError(path, "grid",
                    quoted(gridName) + " is a " + entry->valueType + " grid; narval needs a float grid (" +
@@ -206,14 +201,6 @@ Decoded decodeVdb(const std::string& path, const std::string& gridName, Allocate
   }
   setIndexToWorld(out, map->getAffineMap()->getMat4(), bbox);
   return out;
-}
-
-std::vector<std::string> floatGridNames(const std::string& path) {
-  std::vector<std::string> names;
-  for (const GridEntry& g : sortedByName(listGrids(*readAllGrids(path)))) {
-    if (g.isFloat) names.push_back(g.name);
-  }
-  return names;
 }
 
 // Every grid of the file read whole and described (grid_info.h). Throws InputError.
@@ -326,22 +313,6 @@ bool decodeInChild(const std::string& path, const std::string& gridName, DenseGr
   return true;
 }
 
-bool namesInChild(const std::string& path, std::vector<std::string>& names) {
-  std::string joined;
-  const bool ran = textInChild(path, "cannot list the grids", [&] {
-    std::string out;
-    for (const std::string& n : floatGridNames(path)) out.append(n).push_back('\0');
-    return out;
-  }, &joined);
-  if (!ran) return false;
-  for (size_t start = 0; start < joined.size();) {
-    const size_t end = joined.find('\0', start);
-    names.push_back(joined.substr(start, end - start));
-    start = end + 1;
-  }
-  return true;
-}
-
 bool describeInChild(const std::string& path, std::vector<GridInfo>& infos) {
   std::string text;
   if (!textInChild(path, "cannot describe the grids", [&] { return gridInfoJson(path, describeVdbGrids(path)); },
@@ -362,16 +333,6 @@ std::vector<GridInfo> inspectVdb(const std::string& path) {
   if (describeInChild(path, infos)) return infos;
 #endif
   return describeVdbGrids(path);
-}
-
-std::vector<std::string> vdbGridNames(const std::string& path) {
-  initOpenVdb();
-  requireReadableFile(path);
-#if defined(__linux__)
-  std::vector<std::string> names;
-  if (namesInChild(path, names)) return names;
-#endif
-  return floatGridNames(path);
 }
 
 DenseGrid loadVdb(const std::string& path, const std::string& gridName) {
