@@ -61,9 +61,8 @@ struct ProgramBuildError : std::runtime_error {
 // Builds the embedded kernel file `kernelFile` (e.g. "pathtrace.cl") with `options` (-D defines)
 // and rt.extraBuildOptions.
 // `sources` defaults to kernelSources(); tests pass their own map. Built binaries are cached in
-// $NARVAL_CACHE_DIR, else $XDG_CACHE_HOME/narval, else ~/.cache/narval, keyed by a hash of the
-// flattened source, the options, platform, device and driver version; NARVAL_CACHE_DIR=off disables it.
-// `cacheHit`, when given, says whether the binary came from the cache.
+// programCacheDir(), keyed by a hash of the flattened source, the options, platform, device and
+// driver version. `cacheHit`, when given, says whether the binary came from that cache.
 cl::Program buildProgram(ClRuntime& rt, const std::string& kernelFile, const std::string& options,
                          const std::map<std::string, std::string>* sources = nullptr,
                          bool* cacheHit = nullptr);
@@ -78,8 +77,14 @@ std::string clErrorName(int code);
 // "clCreateContext: CL_DEVICE_NOT_AVAILABLE (-2)" for an exception of the C++ bindings.
 std::string clErrorText(const cl::Error& e);
 
-// The program cache folder (see buildProgram), or "" when NARVAL_CACHE_DIR=off or no home is known.
-std::string programCacheDir();
+// The program cache folder (see buildProgram), or "" for none: $NARVAL_CACHE_DIR ("off": none), else,
+// unless the driver keeps a program cache of its own (`driverCaches`), $XDG_CACHE_HOME/narval or
+// ~/.cache/narval ("" when no home is known).
+std::string programCacheDir(bool driverCaches = false);
+// PoCL caches every program it builds from source (its kcache, keyed by the source and the options,
+// as narval's is), and asking it for a program's binary builds each kernel once more, for a
+// work-group size left to launch time: as long again as the build. There narval's cache only costs.
+bool driverCachesPrograms(const DeviceInfo& device);
 // 64-bit FNV-1a of `data`, continuing from `h`: the program cache's key and checksum.
 std::uint64_t fnv1a64(const std::string& data, std::uint64_t h = 14695981039346656037ull);
 

@@ -142,10 +142,15 @@ std::uint64_t fnv1a64(const std::string& data, std::uint64_t h) {
   return h;
 }
 
-std::string programCacheDir() {
+bool driverCachesPrograms(const DeviceInfo& device) {
+  return device.platformName == "Portable Computing Language";
+}
+
+std::string programCacheDir(bool driverCaches) {
   const std::string narval = envOr("NARVAL_CACHE_DIR");
   if (narval == "off") return "";
   if (!narval.empty()) return narval;
+  if (driverCaches) return "";
   const std::string xdg = envOr("XDG_CACHE_HOME");
   if (!xdg.empty() && xdg[0] == '/') return (fs::path(xdg) / "narval").string();
   const std::string home = envOr("HOME");
@@ -173,7 +178,7 @@ cl::Program buildProgram(ClRuntime& rt, const std::string& kernelFile, const std
   const DeviceInfo& info = rt.selected.info;
 
   fs::path entry;
-  const std::string dir = programCacheDir();
+  const std::string dir = programCacheDir(driverCachesPrograms(info));
   if (!dir.empty()) {
     std::uint64_t key = fnv1a64("narval program cache v1");
     for (const std::string* part : {&source, &fullOptions, &info.platformName, &info.platformVersion,

@@ -411,6 +411,24 @@ TEST(ProgramCache, FolderFollowsTheEnvironment) {
     ScopedEnv home("HOME", std::string("/home/someone"));
     EXPECT_EQ(programCacheDir(), "/home/someone/.cache/narval");
   }
+  // A driver with a cache of its own (PoCL) gets narval's only where NARVAL_CACHE_DIR names a folder.
+  EXPECT_EQ(programCacheDir(/*driverCaches=*/true), "");
   ScopedEnv set("NARVAL_CACHE_DIR", std::string("/var/tmp/nc"));
   EXPECT_EQ(programCacheDir(), "/var/tmp/nc");
+  EXPECT_EQ(programCacheDir(/*driverCaches=*/true), "/var/tmp/nc");
+}
+
+// Without NARVAL_CACHE_DIR a build writes to the default folder exactly when the driver keeps no
+// cache of its own (PoCL keeps one: nothing is written there, and nothing comes from narval's cache).
+TEST(ProgramCache, TheDefaultFolderIsLeftToADriverThatCachesItself) {
+  SKIP_WITHOUT_DEVICES();
+  TempDir home("narval-cache-home");
+  ScopedEnv narval("NARVAL_CACHE_DIR", std::nullopt);
+  ScopedEnv xdg("XDG_CACHE_HOME", home.path().string());
+  ClRuntime rt("");
+  const bool own = driverCachesPrograms(rt.selected.info);
+  EXPECT_EQ(own, rt.selected.info.platformName == "Portable Computing Language");
+  EXPECT_FALSE(runProbeHitsCache(rt, "-DPROBE_FACTOR=5", 5));
+  EXPECT_EQ(fs::exists(home.path() / "narval"), !own);
+  EXPECT_EQ(runProbeHitsCache(rt, "-DPROBE_FACTOR=5", 5), !own);
 }
