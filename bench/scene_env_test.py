@@ -1,27 +1,18 @@
 #!/usr/bin/env python3
-"""bench/scene_env_test.py NARVAL (ctest bench.scene_defaults): the bench scripts take a scene's
-values from narval (`narval scene --resolved`, bench/scene_env.py), never from constants of their own.
-
-A scene without renderer.lobe (algorithm lobe), written into a temporary folder:
-1. speed_vs_error's base viewSteps of the method lobe-corrected (variant "corrected" set by the
-   method) is the loader's default for that variant as `narval scene --keys` reports it (it differs
-   from eq7's: a variant-blind constant fails), and lobe-eq7's base shadowSteps is the loader's;
-2. with renderer.lobe.viewSteps and shadowSteps in the scene, the scene's values win;
-3. run through a narval whose --resolved reports viewSteps 1000 higher, the bench follows it: no
-   constant in the bench stands in for narval's answer;
-4. vs_mitsuba's scene (camera.vfov, renderer.spp, renderer.bounces) is likewise the loader's.
-Exit 0 when every check holds, 1 otherwise (each failure on stderr).
-"""
+"""bench/scene_env_test.py NARVAL (ctest bench.scene_defaults): the bench scripts take a scene's values
+from narval (`narval scene --resolved`, bench/scene_env.py), never from constants of their own. On a
+scene without renderer.lobe: speed_vs_error's base viewSteps of lobe-corrected and shadowSteps of lobe-eq7
+are the loader's defaults as `narval scene --keys` reports them (viewSteps per variant), the scene's
+values win where it has them, and a narval that resolves viewSteps 1000 higher is followed; vs_mitsuba's
+camera.vfov, renderer.spp and renderer.bounces likewise. Exit 0 when every check holds, else 1."""
 import json
 import os
-import stat
 import sys
 import tempfile
 from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
-sys.path.insert(0, str(BENCH))
-sys.path.insert(0, str(BENCH / "vs_mitsuba"))
+sys.path[:0] = [str(BENCH), str(BENCH / "vs_mitsuba")]
 import scene_env  # noqa: E402
 import speed_vs_error  # noqa: E402
 import vs_mitsuba  # noqa: E402
@@ -47,25 +38,29 @@ if done.returncode == 0 and sys.argv[1] == "scene" and "--resolved" in sys.argv:
 sys.stdout.write(out)
 sys.exit(done.returncode)
 """
-
 failures = []
 
 
 def check(what, got, expected):
-    ok = got == expected
-    print("%s %s: %r%s" % ("ok  " if ok else "FAIL", what, got, "" if ok else " (expected %r)" % (expected,)))
-    if not ok:
+    print("%s %s: %r%s" % ("ok  " if got == expected else "FAIL", what, got,
+                           "" if got == expected else " (expected %r)" % (expected,)))
+    if got != expected:
         failures.append(what)
 
 
 def bases(narval, scene_path):
-    """(lobe-corrected's base viewSteps, lobe-eq7's base shadowSteps) in speed_vs_error, as its
-    renders and report use them."""
+    """(lobe-corrected's base viewSteps, lobe-eq7's base shadowSteps) in speed_vs_error."""
     settings = speed_vs_error.parse_args([str(scene_path), "--narval", str(narval), "--methods",
                                           "lobe-eq7,lobe-corrected"])
     scene = speed_vs_error.load_scene(scene_path, settings)
     return (speed_vs_error.base_parameters(settings, scene, "lobe-corrected")["viewSteps"],
             speed_vs_error.base_parameters(settings, scene, "lobe-eq7")["shadowSteps"])
+
+
+def write(path, **changes):
+    """SCENE with top-level sections updated by changes, as JSON at path."""
+    path.write_text(json.dumps(dict(SCENE, **{k: dict(SCENE[k], **v) for k, v in changes.items()})))
+    return path
 
 
 def main(narval):
@@ -78,37 +73,28 @@ def main(narval):
     defaults = dict(zip([first, other], keys["renderer.lobe.viewSteps"]["defaults"]))
     check("scene --keys: renderer.lobe.viewSteps has a default per variant, and they differ",
           len(set(defaults.values())) == 2 and set(defaults) == {"eq7", "corrected"}, True)
+    shadow_steps = keys["renderer.lobe.shadowSteps"]["defaults"]
+    check("scene --keys: renderer.lobe.shadowSteps has one default", len(shadow_steps), 1)
     with tempfile.TemporaryDirectory(prefix="bench_scene_env_") as tmp:
-        tmp = Path(tmp)
-        plain = tmp / "no_lobe.json"
-        plain.write_text(json.dumps(SCENE))
-        shadow_steps = keys["renderer.lobe.shadowSteps"]["defaults"]
-        check("scene --keys: renderer.lobe.shadowSteps has one default", len(shadow_steps), 1)
+        plain = write(Path(tmp) / "no_lobe.json")
         check("(lobe-corrected viewSteps, lobe-eq7 shadowSteps), scene without renderer.lobe (= scene --keys "
               "defaults, viewSteps corrected's)", bases(narval, plain), (defaults["corrected"], shadow_steps[0]))
-
-        explicit = tmp / "lobe_set.json"
-        lobe = {"viewSteps": 7, "shadowSteps": 9}
-        explicit.write_text(json.dumps(dict(SCENE, renderer=dict(SCENE["renderer"], lobe=lobe))))
-        check("(lobe-corrected viewSteps, lobe-eq7 shadowSteps), scene with renderer.lobe %s" % json.dumps(lobe),
+        explicit = write(Path(tmp) / "lobe_set.json", renderer={"lobe": {"viewSteps": 7, "shadowSteps": 9}})
+        check("(lobe-corrected viewSteps, lobe-eq7 shadowSteps), scene with viewSteps 7, shadowSteps 9",
               bases(narval, explicit), (7, 9))
-
-        shifted = tmp / "narval_shifted"
+        shifted = Path(tmp) / "narval_shifted"
         shifted.write_text(SHIFTED_NARVAL % (sys.executable, str(Path(narval).resolve())))
-        shifted.chmod(shifted.stat().st_mode | stat.S_IXUSR)
+        shifted.chmod(0o755)
         check("lobe-corrected viewSteps through a narval that resolves 1000 more", bases(shifted, plain)[0],
               defaults["corrected"] + 1000)
-
-        mitsuba_scene = vs_mitsuba.load_narval_scene(narval, str(plain))
-        for key, got in (("camera.vfov", mitsuba_scene["camera"]["vfov"]), ("renderer.spp", mitsuba_scene["spp"]),
-                         ("renderer.bounces", mitsuba_scene["bounces"])):
+        scene = vs_mitsuba.load_narval_scene(narval, str(plain))
+        for key, got in (("camera.vfov", scene["camera"]["vfov"]), ("renderer.spp", scene["spp"]),
+                         ("renderer.bounces", scene["bounces"])):
             check("vs_mitsuba %s, scene without it (= scene --keys default)" % key, got, keys[key]["defaults"][0])
-        explicit = tmp / "vfov_30.json"
-        explicit.write_text(json.dumps(dict(SCENE, camera=dict(SCENE["camera"], vfov=30),
-                                            renderer=dict(SCENE["renderer"], bounces=5))))
-        mitsuba_scene = vs_mitsuba.load_narval_scene(narval, str(explicit))
+        scene = vs_mitsuba.load_narval_scene(narval, str(write(Path(tmp) / "vfov_30.json", camera={"vfov": 30},
+                                                               renderer={"bounces": 5})))
         check("vs_mitsuba camera.vfov and renderer.bounces, scene with vfov 30 and bounces 5",
-              (mitsuba_scene["camera"]["vfov"], mitsuba_scene["bounces"]), (30, 5))
+              (scene["camera"]["vfov"], scene["bounces"]), (30, 5))
     for what in failures:
         print("scene_env_test: failed: %s" % what, file=sys.stderr)
     return 1 if failures else 0

@@ -1,9 +1,7 @@
 #!/usr/bin/env bash
-# bench/device/gpu_bench.sh [OUTDIR]: on the GPU machine (after `source bench/device/setup.sh`):
-# the three shipped scenes at 1200x600, path tracing 256 spp per grid storage and majorant, and
-# 20 frames of raymarch and lobe per storage; prints a Markdown table; then bench/realtime_frames.sh
-# at 1280x720, and bench/speed_vs_error.py at 1280x720 (every real-time option against 2048-spp
-# references rendered there). Not a test.
+# bench/device/gpu_bench.sh [OUTDIR]: on the GPU machine (after `source bench/device/setup.sh`): path
+# tracing and real-time frames per grid storage and majorant, then bench/realtime.py frames and
+# bench/speed_vs_error.py at 1280x720 (bench/README.md). Not a test.
 set -u
 cd "$(dirname "$0")/../.."
 N=$PWD/build/narval
@@ -25,20 +23,14 @@ for sc in cloud listing_4_1 disney_cloud; do
 done
 python3 - "$out" <<'PY'
 import glob, json, os, sys
-print("| run | storage | majorant | seconds | Msamples/s | median ms/frame |")
-print("|---|---|---|---|---|---|")
+print("| run | storage | majorant | seconds | Msamples/s | median ms/frame |\n|---|---|---|---|---|---|")
 for f in sorted(glob.glob(os.path.join(sys.argv[1], "*.json"))):
     j = json.load(open(f))
-    ms = j.get("ms_per_frame", {}).get("median", "")
-    ms = f"{ms:.2f}" if ms != "" else ""
-    print(f"| {os.path.basename(f)[:-5]} | {j.get('storage')} | {j.get('majorant', '')} | {j['seconds']:.3f} "
-          f"| {j['samples_per_second'] / 1e6:.1f} | {ms} |")
+    ms = "%.2f" % j["ms_per_frame"]["median"] if "ms_per_frame" in j else ""
+    print("| %s | %s | %s | %.3f | %.1f | %s |" % (os.path.basename(f)[:-5], j.get("storage"),
+                                                    j.get("majorant", ""), j["seconds"],
+                                                    j["samples_per_second"] / 1e6, ms))
 PY
-# The real-time kernels at 1280x720 with the light-transmittance cache off and on, on the four
-# shipped scenes (the 2 ms per frame GPU budget; no path-traced references here).
-bench/realtime_frames.sh --resolutions 1280x720 --ref-resolutions "" --frames 20 --out "$out/realtime"
-# Every real-time option against path-traced references at 1280x720 (the 16 ms targets): the
-# references (2048 spp) are rendered on the GPU too, into a cache beside the output, then the
-# methods' sweeps; the report and its budget picks land in $out/speed_vs_error.
+python3 bench/realtime.py frames --resolutions 1280x720 --ref-resolutions "" --frames 20 --out "$out/realtime"
 NARVAL_CACHE_DIR="$out/cache" python3 bench/speed_vs_error.py --resolution 1280x720 --frames 20 \
   --out "$out/speed_vs_error" || echo "failed: speed_vs_error" >&2

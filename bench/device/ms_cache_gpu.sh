@@ -1,29 +1,14 @@
 #!/usr/bin/env bash
-# bench/device/ms_cache_gpu.sh [OUTDIR]: on the GPU machine (after `source bench/device/setup.sh`),
-# the multiple-scattering cache against its GPU targets, in one pass that fits a short lease:
-#   1. the real-time picks at 1280x720 (the view cache with the direct light; tiles 4x wider than
-#      the 320x240 picks, so the columns cover the same angle; and with the filter over its nodes,
-#      within a 100 ms build): cache build ms and ms per frame;
-#   2. 320x240 references of the two Disney scenes at REF_SPP (default 131072) with a snapshot at
-#      a quarter (`narval compare --reference-snapshot` reads their own noise back on the CPU);
-#   3. 320x240 view caches with many paths per node (the caches' bias, with their noise gone), and
-#      the CPU picks of the Disney scenes, to judge against the float references of 2;
-#   4. 1280x720 references (HD_SPP, snapshot at a quarter) and the JND of every image of 1.
-# STAGES (default "1 2 3 4") picks among them. Each render has a time limit (Ctrl-C: it writes what
-# it has). The 320x240 images land in
-# OUTDIR/images.tar, the numbers in OUTDIR/log.txt. Not a test. Grid storage: the buffer for
-# references (no sampler quantisation), the device's default for the real-time frames.
+# bench/device/ms_cache_gpu.sh [OUTDIR]: on the GPU machine (after `source bench/device/setup.sh`), the
+# multiple-scattering cache against its GPU targets in one pass that fits a short lease; STAGES,
+# REF_SPP, HD_SPP, HD_RES, LIMIT and DEADLINE as bench/README.md says. Not a test.
 set -u
 cd "$(dirname "$0")/../.."
 N=$PWD/build/narval
 out=${1:-/tmp/ms-cache-gpu}
-REF_SPP=${REF_SPP:-131072}
-HD_SPP=${HD_SPP:-8192}
-HD_RES=${HD_RES:-1280x720}
-SCALE_PATHS=${SCALE_PATHS:-1}   # a local dry run divides every path count by this
-LIMIT=${LIMIT:-90}              # seconds per render before Ctrl-C
-DEADLINE=${DEADLINE:-480}       # seconds for the whole pass: later renders get what is left, or none
-STAGES=${STAGES:-1 2 3 4}         # which of the stages below to run
+REF_SPP=${REF_SPP:-131072} HD_SPP=${HD_SPP:-8192} HD_RES=${HD_RES:-1280x720} STAGES=${STAGES:-1 2 3 4}
+LIMIT=${LIMIT:-90} DEADLINE=${DEADLINE:-480}
+SCALE_PATHS=${SCALE_PATHS:-1}  # a local dry run divides every path count by this
 mkdir -p "$out/img" "$out/hd"
 t0=$(date +%s)
 stamp() { echo "[$(($(date +%s) - t0)) s] $*"; }
@@ -46,7 +31,6 @@ view() {  # view TILE PATHS STEPS [FILTER TOLERANCE TWICING GUIDE ALLOCATION]: t
     shift
   done
 }
-nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null
 "$N" devices
 for s in cloud smoke disney_cloud disney_cloud_front; do  # fills the program cache
   "$N" render "$(sc $s)" -o "$out/warm.exr" --resolution 64x48 $(view 2 32 30) >/dev/null 2>&1 || echo "warm-up failed: $s"
@@ -79,8 +63,7 @@ hd_configs=(
 stage 1 && stamp "1. real-time picks at $HD_RES"
 stage 1 && for c in "${hd_configs[@]}"; do
   set -- $c
-  run render "$(sc $1)" -o "$out/hd/$2.exr" --resolution "$HD_RES" --frames 20 \
-    $(view "${@:3}") \
+  run render "$(sc $1)" -o "$out/hd/$2.exr" --resolution "$HD_RES" --frames 20 $(view "${@:3}") \
     --stats-json "$out/hd/$2.json" | grep -v '^wrote'
 done
 stage 2 && stamp "2. 320x240 references at $REF_SPP spp"
@@ -101,9 +84,8 @@ lo_configs=(
 )
 stage 3 && for c in "${lo_configs[@]}"; do
   set -- $c
-  run render "$(sc $1)" -o "$out/img/$2.exr" --resolution 320x240 --frames 3 --seed 1 \
-    $(view $3 $4 30 "${@:5}") \
-    --stats-json "$out/img/$2.json" | grep -v '^wrote'
+  run render "$(sc $1)" -o "$out/img/$2.exr" --resolution 320x240 --frames 3 $(view $3 $4 30 "${@:5}") \
+    --seed 1 --stats-json "$out/img/$2.json" | grep -v '^wrote'
 done
 (stage 2 || stage 3) && (cd "$out/img" && tar -cf "$out/images.tar" ./*.exr ./*.json)
 stage 4 && stamp "4. $HD_RES references at $HD_SPP spp and the JND of the picks"
@@ -123,8 +105,7 @@ done
 stamp done
 python3 - "$out/hd" <<'PY'
 import glob, json, os, sys
-print("| run | ms_cache_ms | median ms/frame | wall ms/frame |")
-print("|---|---|---|---|")
+print("| run | ms_cache_ms | median ms/frame | wall ms/frame |\n|---|---|---|---|")
 for f in sorted(glob.glob(os.path.join(sys.argv[1], "*.json"))):
     j = json.load(open(f))
     m = j["ms_per_frame"]

@@ -1,10 +1,7 @@
 #!/usr/bin/env bash
 # bench/device/pack.sh: packs what a run on the lent GPU machine needs into .devrun/ (ignored via
-# .git/info/exclude; name it in the device tool's `carry`). That machine is not Debian and has no
-# narval dependencies: this carries the built binaries, their shared libraries (xz, ~7 MB), an ICD
-# file naming NVIDIA's libnvidia-opencl.so.1, the small Disney cloud and the OpenVDB smoke. There, in the repository
-# root: `source bench/device/setup.sh`, then run build/narval, the test binaries or
-# bench/device/gpu_bench.sh. See bench/RESULTS.md ("NVIDIA H100") for what worked.
+# .git/info/exclude; name it in the device tool's `carry`): the built binaries, their shared libraries,
+# an ICD file naming NVIDIA's libnvidia-opencl.so.1, the Disney cloud and the smoke (bench/README.md).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 [ -x build/narval ] || scripts/setup.sh >/dev/null

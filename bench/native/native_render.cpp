@@ -1,18 +1,9 @@
 // narval-native: the native baseline (issue 6, item 4). Loads a scene with the CLI's own host code
 // (loadScene with the same --set overrides, loadSceneGrids, buildDeviceScene), renders it with the
 // shared kernel headers compiled as C++ on N host threads (native_render.h), writes a 32-bit float
-// EXR and prints the timing as one JSON object on stdout. bench/native_baseline.sh runs it beside
-// `narval render` (PoCL) and reports the PoCL/native time ratio.
-//
-//   narval-native SCENE.json [-o OUT.exr] [--algorithm A] [--spp N] [--bounces N] [--resolution WxH]
-//                 [--seed N] [--set PATH=VALUE ...] [--threads N] [--frames K] [--majorant grid|global]
-//                 [--majorant-resolution N] [--stats-json FILE] [--compare REF.exr]
-//
-// --frames K renders K times and reports per-frame ms (the first apart; median, min, max of the
-// others), like narval render's --frames for the real-time algorithms; "seconds" is then that
-// median. The image is the last render (every render is the same).
-// --compare REF.exr: how many pixels equal REF's bit for bit, and the largest differences (REF is
-// normally the PoCL render of the same settings; the only arithmetic differences are libm's).
+// EXR and prints the timing as one JSON object; bench/native_baseline.py runs it beside PoCL.
+// --frames K: per-frame ms like narval render's (the first apart; "seconds" is the others' median).
+// --compare REF.exr: how many pixels equal REF's bit for bit, and the largest differences.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -200,7 +191,7 @@ int main(int argc, char** argv) {
   app.add_option("--majorant-resolution", a.majorantResolution,
                  "Majorant cells along the longest axis (0: buildDeviceScene's automatic choice; narval render "
                  "may choose otherwise per device: give what its --stats-json majorant_cells says, as "
-                 "bench/native_baseline.sh does)")
+                 "bench/native_baseline.py does)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--stats-json", a.statsJson, "Also write the JSON to FILE");
   app.add_option("--compare", a.compare, "Compare bit for bit with REF.exr (e.g. the PoCL render)");

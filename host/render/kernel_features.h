@@ -12,9 +12,9 @@
 // Each is derived from the values the kernel would test at run time (DeviceScene.params and .lights), so a specialised
 // kernel takes the generic branch by construction: same pixels, bit for bit (tests/render/kernel_features_test.cpp).
 // Phase and grey/chromatic need a medium; without the defines (as in host-compiled headers) the kernels keep the
-// runtime branches. NARVAL_GENERIC=1 (measurement, debugging: bench/specialisation.sh; read at every buildDeviceScene)
-// turns specialisation off but for MEDIUM_HOMOGENEOUS, which is none (the grid argument is an int then); the generic
-// kernel gets -DEMISSION, testing the emission kind at run time.
+// runtime branches. NARVAL_GENERIC=1 (measurement, debugging: bench/kernel_ab.py specialisation; read at every
+// buildDeviceScene) turns specialisation off but for MEDIUM_HOMOGENEOUS, which is none (the grid argument is an int
+// then); the generic kernel gets -DEMISSION, testing the emission kind at run time.
 //
 // The driver's choices, after those:
 //   -DGRID_STORAGE_BUFFER / -DGRID_STORAGE_BRICKS  buffer or bricks, not the image (grid.h; render/device_grid.h)

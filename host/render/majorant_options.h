@@ -2,7 +2,7 @@
 // applied to a scene on the device: the majorant grid's resolution, re-uploaded when it changes, and
 // the path tracer's -D options (kernels/shared/tracking.h: -DMAJORANT_GLOBAL, -DCOUNTERS).
 //
-// Defaults, by measurement (bench/majorant.sh; numbers in bench/RESULTS.md):
+// Defaults, by measurement (bench/majorant.py; numbers in bench/RESULTS.md):
 // - majorant "auto": the grid on CPU devices (on PoCL faster than the global majorant on both
 //   clouds), the global majorant on GPUs (on an H100 a DDA cell step costs about what a
 //   hardware-filtered lookup saves: the grid at best no faster, slower with more cells).

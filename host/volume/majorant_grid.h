@@ -38,7 +38,7 @@ void majorantVoxelRange(double cellMin, double cellMax, int n, int* lo, int* hi)
 MajorantGrid buildMajorantGrid(const DenseGrid& density, int cellsX, int cellsY, int cellsZ);
 
 // The automatic majorant grid resolution: cells along the grid's longest axis (chosen by
-// measurement, bench/majorant.sh).
+// measurement, bench/majorant.py).
 constexpr int kDefaultMajorantResolution = 16;
 
 // About `target` cells along the grid's longest axis and the same cell edge (rounded) along the
