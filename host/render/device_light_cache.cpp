@@ -10,12 +10,15 @@
 
 namespace narval {
 
-node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes) {
+node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, double shadowRaysPerFrame,
+                                  size_t maxAllocBytes) {
   int cells = resolution == kLightCacheAuto ? kLightCacheAutoResolution : resolution;
   for (;;) {
     const node_grid_params c = nodeGridLayout(ds, cells);
+    if (resolution != kLightCacheAuto) return c;
     const size_t bytes = nodeGridCount(c) * size_t(std::max(1, ds.params.num_lights)) * sizeof(float);
-    if (resolution != kLightCacheAuto || bytes <= maxAllocBytes || cells <= 1) return c;
+    if (bytes <= maxAllocBytes || cells <= 1)
+      return double(nodeGridCount(c)) > shadowRaysPerFrame ? node_grid_params{} : c;
     cells /= 2;
   }
 }

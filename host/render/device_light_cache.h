@@ -17,14 +17,17 @@
 
 namespace narval {
 
-// renderer.lightCache.resolution "auto": longest-axis cells, measured (bench/realtime_tuning.sh; bench/RESULTS.md).
+// renderer.lightCache.resolution "auto": longest-axis cells, measured (bench/realtime.py tuning; bench/RESULTS.md).
 constexpr int kLightCacheAutoResolution = 64;
 
 // The cache's layout: `resolution` cells on the medium box's longest world-space axis, the others in
 // proportion (at least one), nodes = cells + 1 per axis; nx = 0 (no cache) for resolution 0 or no medium.
 // kLightCacheAuto starts at kLightCacheAutoResolution, halving until every light's slabs fit `maxAllocBytes`
-// (the device's largest allocation); an explicit one is kept (update() then throws).
-node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, size_t maxAllocBytes = SIZE_MAX);
+// (the device's largest allocation), and is off where a frame marches fewer shadow rays per light
+// (`shadowRaysPerFrame`) than the cache has nodes: building it would march more than it saves, and the
+// marched shadows are exact. An explicit resolution is kept (update() then throws if it does not fit).
+node_grid_params lightCacheLayout(const DeviceScene& ds, int resolution, double shadowRaysPerFrame,
+                                  size_t maxAllocBytes = SIZE_MAX);
 
 // The column densities of every light's slab computed on the host with the shared header (what the
 // device builds; unit tests and the native baseline use it). `grid` reads the medium's density.

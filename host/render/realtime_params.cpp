@@ -1,5 +1,6 @@
 #include "render/realtime_params.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "render/device_light_cache.h"
@@ -96,7 +97,7 @@ ms_cache_params msCacheParams(const MsCacheSettings& mc, bool on, const DeviceSc
 
 }  // namespace
 
-RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes) {
+RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes, double cachePixels) {
   const RendererSettings& r = scene.renderer;
   RealtimeParams p;
   switch (r.algorithm) {
@@ -111,7 +112,11 @@ RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t 
     case Algorithm::Pathtrace: throw std::logic_error("realtimeParams: the path tracer has none");
   }
   // No light loop when the multiple-scattering cache holds the direct light: no shadow rays to cache.
-  if (!p.msCache.direct) p.lightCache = lightCacheLayout(ds, r.lightCache.resolution, maxAllocBytes);
+  // A pixel reads a shadow per light at each view step (the ray marcher) or lobe point (the lobe).
+  const double pixels = cachePixels > 0 ? cachePixels : double(r.width) * double(r.height);
+  const double raysPerPixel = std::max(1, r.algorithm == Algorithm::Lobe ? p.lobe.points : p.march.steps);
+  if (!p.msCache.direct)
+    p.lightCache = lightCacheLayout(ds, r.lightCache.resolution, pixels * raysPerPixel, maxAllocBytes);
   return p;
 }
 

@@ -22,6 +22,9 @@ struct RealtimeParams {
 
 // The blocks for the scene's algorithm; the caches' layouts need the scene as uploaded.
 // maxAllocBytes: the device's largest allocation, which an automatic cache resolution must fit.
-RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes = SIZE_MAX);
+// cachePixels: the image size the automatic light cache is weighed against (lightCacheLayout); 0 takes
+// the scene's own resolution.
+RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes = SIZE_MAX,
+                              double cachePixels = 0);
 
 }  // namespace narval

@@ -18,7 +18,11 @@ namespace narval {
 
 RealtimeRenderer::RealtimeRenderer(ClRuntime& rt, const Scene& scene, SceneGrids grid,
                                    const RenderOptions& options)
-    : rt_(rt), view_(scene), options_(options), dev_(rt, checkedScene(scene, options), grid) {
+    : rt_(rt),
+      view_(scene),
+      options_(options),
+      dev_(rt, checkedScene(scene, options), grid),
+      cachePixels_(double(scene.renderer.width) * double(scene.renderer.height)) {
   const std::string algorithm = algorithmName(scene.renderer.algorithm);
   warnings_ = dev_.scene.warnings;
   stats_ = initialStats(algorithm, rt, scene);
@@ -65,7 +69,7 @@ void RealtimeRenderer::setView(const Scene& view) {
   }
   // Each kernel takes the blocks of its features (realtime_params.h); a cache that is off reads a
   // placeholder, never touched.
-  const RealtimeParams params = realtimeParams(view, dev_.scene, rt_.selected.info.maxAllocBytes);
+  const RealtimeParams params = realtimeParams(view, dev_.scene, rt_.selected.info.maxAllocBytes, cachePixels_);
   kernel_.set("march", params.march);
   kernel_.set("light_cache", params.lightCache);
   if (params.lightCache.nx == 0) kernel_.set("light_cache_nodes", noCache_);

@@ -33,7 +33,9 @@ class RealtimeRenderer {
   // the caches are built by the first frame.
   RealtimeRenderer(ClRuntime& rt, const Scene& scene, SceneGrids grid, const RenderOptions& options = {});
   // The next frames show `view`: the constructor's scene with another camera, renderer.resolution or
-  // renderer.raymarch / renderer.lobe settings (its medium, lights and algorithm unchanged).
+  // renderer.raymarch / renderer.lobe settings (its medium, lights and algorithm unchanged). The
+  // automatic light cache is weighed against the constructor's resolution, so that frames drawn
+  // smaller (a viewer in motion) keep it.
   void setView(const Scene& view);
   // One frame: brings the caches up to date (progressiveCache: at most one launch of the
   // multiple-scattering cache, so a viewer refines it over frames; otherwise all of it), then one
@@ -53,6 +55,7 @@ class RealtimeRenderer {
   Scene view_;
   RenderOptions options_;
   DeviceSceneBuffers dev_;
+  double cachePixels_;  // the constructor's image size (realtimeParams)
   RealtimeParams params_;
   DeviceLightCache lightCache_;
   DeviceMsCache msCache_;

@@ -161,11 +161,14 @@ int ViewerSession::chooseLevel() const {
 RealtimeRenderer& ViewerSession::realtime(const Scene& view) {
   std::unique_ptr<RealtimeRenderer>& r = algorithm_ == Algorithm::Raymarch ? raymarch_ : lobe_;
   if (!r) {
-    r = std::make_unique<RealtimeRenderer>(rt_, view, grid_, options_.render);
+    // Made at the full size, whatever this frame's: the automatic light cache is weighed against it.
+    Scene full = view;
+    full.renderer.width = scene_.renderer.width;
+    full.renderer.height = scene_.renderer.height;
+    r = std::make_unique<RealtimeRenderer>(rt_, full, grid_, options_.render);
     for (const std::string& w : r->warnings()) messages_.push_back("warning: " + w);
-  } else {
-    r->setView(view);
   }
+  r->setView(view);
   return *r;
 }
 

@@ -28,7 +28,7 @@ class LightCacheCli : public CliFixture {
         {"name": "box", "type": "volume", "transform": {"scale": [2, 2, 2]}, "materialName": "cloud"}
       ],
       "camera": {"position": [0, 0, -6], "lookAt": [0, 0, 0], "vfov": 30},
-      "renderer": {"resolution": [24, 18], "algorithm": "raymarch"},
+      "renderer": {"resolution": [24, 18], "algorithm": "raymarch", "lightCache": {"resolution": 32}},
       "background": [0.05, 0.05, 0.1]
     })");
   }
@@ -41,13 +41,21 @@ TEST_F(LightCacheCli, FramesBuildTheCacheOnceAndTheStatsReportIt) {
     const RunResult r = run(std::string("render s.json -o a.exr --frames 5 --stats-json a.json --algorithm ") + algorithm);
     ASSERT_EQ(r.code, 0) << r.err;
     const nlohmann::json s = stats("a.json");
-    EXPECT_EQ(s["light_cache_cells"], nlohmann::json::array({64, 64, 64}));  // auto on a cubic box
+    EXPECT_EQ(s["light_cache_cells"], nlohmann::json::array({32, 32, 32}));  // a cubic box
     EXPECT_EQ(s["light_cache_builds"], 2);  // one slab per light, for five frames
-    EXPECT_EQ(s["light_cache_bytes"], 65 * 65 * 65 * 2 * 4);
+    EXPECT_EQ(s["light_cache_bytes"], 33 * 33 * 33 * 2 * 4);
     EXPECT_GT(s["light_cache_ms"].get<double>(), 0.0);
     EXPECT_EQ(s["passes"], 5);
-    EXPECT_NE(r.out.find("\nlight cache: 64x64x64 cells, 2 lights built in "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\nlight cache: 32x32x32 cells, 2 lights built in "), std::string::npos) << r.out;
     EXPECT_NE(r.out.find(" ms (not in the frame times)\n"), std::string::npos) << r.out;
+  }
+  // auto: 64 cells where a frame reads at least as many shadows per light as they have nodes (65³ =
+  // 274625: 160x120 pixels x 30 steps = 576000), none below (24x18 x 30 = 12960: marched exactly).
+  for (const auto& [size, cells] : {std::pair{"160x120", 64}, std::pair{"24x18", 0}}) {
+    const RunResult a = run(std::string("render s.json -o c.exr --stats-json c.json --resolution ") + size +
+                            " --set renderer.lightCache.resolution=\\\"auto\\\"");
+    ASSERT_EQ(a.code, 0) << a.err;
+    EXPECT_EQ(stats("c.json")["light_cache_cells"], nlohmann::json::array({cells, cells, cells})) << size;
   }
   const RunResult off = run("render s.json -o b.exr --stats-json b.json --set renderer.lightCache.resolution=0");
   ASSERT_EQ(off.code, 0) << off.err;

@@ -43,6 +43,9 @@ struct Cache {
   std::vector<float> slabs;
 };
 
+// Shadow rays a frame reads per light: more than any cache here has nodes (lightCacheLayout).
+constexpr double kManyRays = 1e12;
+
 // The cache of `json`'s scene at `cells` cells per axis (a cube), built with `steps` samples per node.
 Cache buildCache(const std::string& json, int cells, int steps = 16, const DenseGrid* density = nullptr) {
   Cache c;
@@ -50,7 +53,7 @@ Cache buildCache(const std::string& json, int cells, int steps = 16, const Dense
   c.grid = grid_view{density ? density->data.data() : nullptr, density ? density->nx : 1, density ? density->ny : 1,
                      density ? density->nz : 1, c.ds.majorants.data()};
   c.march.shadow_steps = steps;
-  c.layout = lightCacheLayout(c.ds, cells);
+  c.layout = lightCacheLayout(c.ds, cells, kManyRays);
   c.slabs = buildLightCacheOnHost(c.ds, &c.grid, c.march, c.layout);
   return c;
 }
@@ -87,20 +90,27 @@ TEST(LightCache, LayoutFollowsTheBoxsLongestWorldAxis) {
   std::string json = boxWithPointLight("[0, 0, 3]");
   json.replace(json.find("\"scale\": [1, 1, 1]"), 18, "\"scale\": [4, 1, 2]");
   const DeviceScene ds = buildDeviceScene(parseScene(json, "layout.json"), nullptr);
-  const node_grid_params c = lightCacheLayout(ds, 32);
+  const node_grid_params c = lightCacheLayout(ds, 32, kManyRays);
   EXPECT_EQ(c.nx, 33);
   EXPECT_EQ(c.ny, 9);
   EXPECT_EQ(c.nz, 17);
-  EXPECT_EQ(lightCacheLayout(ds, 0).nx, 0);  // off
-  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto).nx, kLightCacheAutoResolution + 1);
+  EXPECT_EQ(lightCacheLayout(ds, 0, kManyRays).nx, 0);  // off
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, kManyRays).nx, kLightCacheAutoResolution + 1);
   // auto halves its resolution until the slabs fit the device's largest allocation: at 64 cells
   // 65·17·33 nodes · 4 bytes = 145860 bytes for the one light; a 100000-byte device gets 32 cells
   // (33·9·17 nodes, 20196 bytes). An explicit resolution is kept (its allocation then fails with
   // a message naming the key).
-  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 145860).nx, 65);
-  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 100000).nx, 33);
-  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 100000).ny, 9);
-  EXPECT_EQ(lightCacheLayout(ds, 64, 100000).nx, 65);
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, kManyRays, 145860).nx, 65);
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, kManyRays, 100000).nx, 33);
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, kManyRays, 100000).ny, 9);
+  EXPECT_EQ(lightCacheLayout(ds, 64, kManyRays, 100000).nx, 65);
+  // auto is off where a frame reads fewer shadows per light than the cache has nodes (65·17·33 =
+  // 36465 at 64 cells; 5049 at the 32 cells a 100000-byte device gets); an explicit one stays.
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 36465).nx, 65);
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 36464).nx, 0);
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 5049, 100000).nx, 33);
+  EXPECT_EQ(lightCacheLayout(ds, kLightCacheAuto, 5048, 100000).nx, 0);
+  EXPECT_EQ(lightCacheLayout(ds, 64, 1).nx, 65);
   // The corner nodes sit on the box's corners in world space.
   const vec3 far = affine_point(c.index_to_world, node_grid_point(&c, vec3_from4(ds.params.medium.dims),
                                                                          node_grid_count(&c) - 1));
