@@ -121,9 +121,9 @@ TEST_F(FarmCli, RefusalsComeBeforeAnyFileIsWritten) {
 // A task SIGKILLed mid-render: reported with its range and log, nothing merged, exit 1. The same
 // command again renders only that task and completes the image, the single render's bits.
 TEST_F(FarmCli, AKilledTaskIsReportedAndRunningAgainRendersOnlyIt) {
-  scene(64, 48, 12000);  // 4000 spp a task: about 2 s here, time to be killed mid-render
+  scene(32, 24, 12000);  // 4000 spp a task: about 1 s here, time to be killed mid-render
   const std::string farm = "farm fog.json --tasks 3 --scheduler local -o out.exr --submit";
-  const RunResult r = farmKillingTask(farm, "4000:8000", std::chrono::milliseconds(300));
+  const RunResult r = farmKillingTask(farm, "4000:8000", std::chrono::milliseconds(100));
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_EQ(r.err, "narval: farm: task 1 samples [4000, 8000) failed: no output written; its log: " +
                        file("out.farm/logs/task_1.log") +
@@ -147,9 +147,9 @@ TEST_F(FarmCli, AKilledTaskIsReportedAndRunningAgainRendersOnlyIt) {
 // only) and the image is the single render's bits. A part of another render in the job folder
 // (another seed) is not continued but rendered again.
 TEST_F(FarmCli, AKilledTaskContinuesFromItsCheckpoint) {
-  scene(64, 48, 12000);
+  scene(32, 24, 12000);
   const std::string farm = "farm fog.json --tasks 3 --scheduler local -o out.exr --submit --checkpoint 0.2";
-  const RunResult r = farmKillingTask(farm, "4000:8000", std::chrono::milliseconds(300), "out.farm/parts/part_1.exr");
+  const RunResult r = farmKillingTask(farm, "4000:8000", std::chrono::milliseconds(100), "out.farm/parts/part_1.exr");
   EXPECT_EQ(r.code, 1) << r.err;
   const auto cut = readExrAttributes(file("out.farm/parts/part_1.exr"));
   EXPECT_EQ(cut.at("narval:sample_begin"), "4000");
@@ -195,9 +195,9 @@ TEST_F(FarmCli, SlurmRunsTheTasksAsAnArrayAndTheMergeAfterThem) {
   EXPECT_NE(test::readFile(dir_ / "out.farm/tasks.sbatch").find("#SBATCH --array=0-3\n"), std::string::npos);
   EXPECT_NE(test::readFile(dir_ / "out.farm/submit.sh").find("--dependency=afterok:$array"), std::string::npos);
 
-  scene(64, 48, 9000);
+  scene(32, 24, 9000);
   const std::string farm = "farm fog.json --tasks 3 --scheduler slurm -o killed.exr --submit";
-  r = farmKillingTask(farm, "3000:6000", std::chrono::milliseconds(300));
+  r = farmKillingTask(farm, "3000:6000", std::chrono::milliseconds(100));
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_NE(r.err.find("narval: farm: task 1 samples [3000, 6000) failed: no output written; its log: " +
                        file("killed.farm/logs/task_1.log")),
