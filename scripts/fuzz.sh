@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # scripts/fuzz.sh [SECONDS]: builds the libFuzzer targets for the scene parser and the .vol parser
 # (fuzz/, clang with address and undefined-behaviour sanitizers) in build-fuzz/ and runs each for
-# SECONDS (default: $NARVAL_FUZZ_SECONDS, else 60; 0 skips), both at once, starting from the seed
+# SECONDS (default: $NARVAL_FUZZ_SECONDS, else 30; 0 skips), both at once, starting from the seed
 # corpus in fuzz/corpus/ copied into build-fuzz/corpus/ (the repository is not written to; the
 # scratch corpus grows from run to run). Exits 1 on any finding (crash, sanitizer report, leak,
 # timeout, allocation over the limit, or an error that is not one InputError line) and names the
@@ -9,7 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-seconds=${1:-${NARVAL_FUZZ_SECONDS:-60}}
+seconds=${1:-${NARVAL_FUZZ_SECONDS:-30}}
 if ! [[ $seconds =~ ^[0-9]+$ ]]; then
   echo "fuzz: SECONDS must be a whole number, got '$seconds'" >&2
   exit 2

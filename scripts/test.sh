@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # scripts/test.sh [CTEST ARGS]: set up, then run the whole ctest suite (output shown on failure), then
-# fuzz the scene and .vol parsers (scripts/fuzz.sh: $NARVAL_FUZZ_SECONDS per target, default 60, 0
+# fuzz the scene and .vol parsers (scripts/fuzz.sh: $NARVAL_FUZZ_SECONDS per target, default 30, 0
 # skips). With arguments, ctest gets them and the fuzzing is left out: `scripts/test.sh -L unit` is
 # the quick subset (labels: unit, device, render, cli, farm, docs).
 # The farm tests use Open Job Description's runner, `openjd` from PyPI's openjd-cli: installed here
