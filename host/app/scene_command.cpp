@@ -30,7 +30,8 @@ nlohmann::json keyTableJson() {
 }  // namespace
 
 Command addSceneCommand(CLI::App& app) {
-  CLI::App* sub = app.add_subcommand("scene", "Print a scene as narval renders it (--resolved), or the scene format's keys (--keys)");
+  CLI::App* sub = app.add_subcommand(
+      "scene", "Print a scene as narval renders it (--resolved), or the scene format's keys (--keys)");
   auto a = std::make_shared<SceneArgs>();
   sub->add_option("SCENE.json", a->scene, "Scene file (with --resolved)");
   sub->add_option("--set", a->sets, "Override a scene value: dotted.path=value (repeatable)");

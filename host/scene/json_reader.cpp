@@ -256,7 +256,8 @@ int64_t checkIntRange(const JsonContext& ctx, const std::string& key, int64_t v,
 }
 
 int readInt(ObjectReader& r, const std::string& name, int fallback, int64_t lo, int64_t hi) {
-  r.noteRange(name, hi == kIntMax ? ">= " + std::to_string(lo) : "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  r.noteRange(name,
+              hi == kIntMax ? ">= " + std::to_string(lo) : "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   return static_cast<int>(checkIntRange(r.context(), r.keyOf(name), r.getInteger(name, fallback), lo, hi));
 }
 
@@ -268,9 +269,16 @@ float readNonNegative(ObjectReader& r, const std::string& name, float fallback) 
 }
 
 float readUnitInterval(ObjectReader& r, const std::string& name, float fallback) {
+  return readInRange(r, name, fallback, 0, 1);
+}
+
+std::string closedRange(float lo, float hi) { return "[" + formatNumber(lo) + ", " + formatNumber(hi) + "]"; }
+
+float readInRange(ObjectReader& r, const std::string& name, float fallback, float lo, float hi) {
   const float v = r.getFloat(name, fallback);
-  r.noteRange(name, "[0, 1]");
-  if (!(v >= 0 && v <= 1)) r.context().fail(r.keyOf(name), "must be in [0, 1], got " + formatNumber(v));
+  r.noteRange(name, closedRange(lo, hi));
+  if (!(v >= lo && v <= hi))
+    r.context().fail(r.keyOf(name), "must be in " + closedRange(lo, hi) + ", got " + formatNumber(v));
   return v;
 }
 

@@ -148,5 +148,9 @@ int64_t checkIntRange(const JsonContext& ctx, const std::string& key, int64_t v,
 int readInt(ObjectReader& r, const std::string& name, int fallback, int64_t lo, int64_t hi = kIntMax);
 float readNonNegative(ObjectReader& r, const std::string& name, float fallback);
 float readUnitInterval(ObjectReader& r, const std::string& name, float fallback);
+// "[lo, hi]", as the messages and the key table write a closed range.
+std::string closedRange(float lo, float hi);
+// A number in [lo, hi]: "KEY: must be in [lo, hi], got x" otherwise.
+float readInRange(ObjectReader& r, const std::string& name, float fallback, float lo, float hi);
 
 }  // namespace narval::scene_detail

@@ -73,7 +73,8 @@ float readMinTransmittance(ObjectReader& r, float fallback) {
 AreaLightPhase readAreaLightPhase(ObjectReader& r, AreaLightPhase fallback) {
   const AreaLightPhase v = readEnum(r, "areaLightPhase", kAreaLightPhases, fallback);
   if (v == AreaLightPhase::Exact)
-    r.context().warnIfChanged(r.keyOf("areaLightSamples"), "applies to areaLightPhase \"points\"; \"exact\" ignores it");
+    r.context().warnIfChanged(r.keyOf("areaLightSamples"),
+                              "applies to areaLightPhase \"points\"; \"exact\" ignores it");
   return v;
 }
 
@@ -178,7 +179,8 @@ RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::st
   const char* ms = enumName(kMultipleScattering, s.multipleScattering);
   if (s.multipleScattering != MultipleScattering::Octaves)
     for (const char* k : {"octaveScattering", "octaveExtinction", "octavePhase"})
-      ctx.warnIfChanged(m.keyOf(k), std::string("applies to multipleScattering \"octaves\"; \"") + ms + "\" ignores it");
+      ctx.warnIfChanged(m.keyOf(k),
+                        std::string("applies to multipleScattering \"octaves\"; \"") + ms + "\" ignores it");
   s.msCache = readMsCache(ctx, section(m, "msCache"), m.keyOf("msCache"), s.msCache);
   if (s.multipleScattering != MultipleScattering::Cache && ctx.changedUnder(m.keyOf("msCache")))
     ctx.warn(m.keyOf("msCache"), std::string("applies to multipleScattering \"cache\"; \"") + ms + "\" ignores it");

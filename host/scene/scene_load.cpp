@@ -103,7 +103,7 @@ void readPhaseParameter(ObjectReader& r, Material& m) {
     if (!k.key) continue;
     if (k.id == m.phase) m.phaseParameter = k.fallback;
     const json* v = r.find(k.key);
-    const std::string range = "[" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "]";
+    const std::string range = closedRange(k.lo, k.hi);
     r.note(k.key, "number", k.id == m.phase ? jsonNumber(k.fallback) : json(), range);
     if (!v) continue;
     const std::string key = r.keyOf(k.key);
@@ -236,13 +236,7 @@ void readLightKeys(ObjectReader& r, Primitive& p) {
       p.lightVector = r.requireVec3(k.vectorKey);
       if (p.lightVector == Vec3f{0, 0, 0}) r.context().fail(r.keyOf(k.vectorKey), "must be non-zero");
     }
-    if (k.key) {
-      p.lightParameter = r.getFloat(k.key, k.fallback);
-      r.noteRange(k.key, "[" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "]");
-      if (!(p.lightParameter >= k.lo && p.lightParameter <= k.hi))
-        r.context().fail(r.keyOf(k.key), "must be in [" + formatNumber(k.lo) + ", " + formatNumber(k.hi) + "], got " +
-                                             formatNumber(p.lightParameter));
-    }
+    if (k.key) p.lightParameter = readInRange(r, k.key, k.fallback, k.lo, k.hi);
   }
 }
 

@@ -43,7 +43,6 @@ DenseGrid loadVol(const std::string& path);
 // Reads `chunkBytes` at a time (small ones test the boundaries); a token as long as a chunk is not a number.
 DenseGrid parseVol(std::istream& in, const std::string& path, size_t chunkBytes = size_t(1) << 20);
 
-
 // Writes a FloatGrid named `gridName` (fog volume, zero background, zeros inactive, uniform voxel
 // size, index (0,0,0) at the origin), atomically (PATH.tmp, then renamed). Throws InputError when the
 // file cannot be written, std::invalid_argument for NaN values or data that does not match the dims.

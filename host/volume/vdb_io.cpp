@@ -50,7 +50,6 @@ void initOpenVdb() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
-
 namespace {
 
 // What a file OpenVDB cannot read is: its own messages ("iostream error", "Map is not registered")
@@ -97,7 +96,8 @@ openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
 // The grids' names and types, sorted by name so that a message does not depend on the writer's order.
 std::vector<GridEntry> listGrids(const openvdb::GridPtrVec& grids) {
   std::vector<GridEntry> out;
-  for (const openvdb::GridBase::Ptr& g : grids) out.push_back({g->getName(), g->valueType(), g->isType<openvdb::FloatGrid>()});
+  for (const openvdb::GridBase::Ptr& g : grids)
+    out.push_back({g->getName(), g->valueType(), g->isType<openvdb::FloatGrid>()});
   std::sort(out.begin(), out.end(), [](const GridEntry& a, const GridEntry& b) { return a.name < b.name; });
   return out;
 }
