@@ -54,14 +54,20 @@
  *     depth_factor/σ̄t assumes unit density, so in a thin wisp or a dense core c lands where nothing
  *     scatters (black core and white ring on the default cloud); weighting by S matters for back-lit
  *     media (bench/RESULTS.md). Early termination as above: the samples left weigh below ε' together, so
- *     1 − T_v is off by less than ε' (the in-scattered term by a relative ε'/(1 − ε')).
+ *     1 − T_v is off by less than ε' (the in-scattered term by a relative ε'/(1 − ε')). Sub-steps: the
+ *     samples follow the occupied cells, so where a step spans several mean free paths its one
+ *     midpoint can fall short of or far past where the density rises, and c jumps between pixels whose
+ *     rays cross different cells (patches shaped like the cells on a dense front-lit cloud). A step
+ *     whose majorant optical depth x (the cell's majorant density times σ̄t·Δ) exceeds 1 is split into
+ *     min(⌊x⌋ + 1, LOBE_SUBSTEPS) sub-steps over its own length.
  * C3. Scale: r = radius/σ̄t, radius in mean free paths of unit density. Scaling geometry by s and σ by
  *     1/s scales r, t_c and every segment by s and leaves every optical depth, T_v, phase angle and
  *     (rectangle lights, I ∝ area) I/d² unchanged: the same image, which Eq. 7's world-unit r breaks.
  * C4. P_i = c + min(r, distance from c to the box along d_i)·d_i: a point outside the box sees its light
  *     unshadowed, which Eq. 7 paints as a bright ring around silhouettes.
  * Result: L = L_b·T_v + (1 − T_v)·albedo ⊙ (1/n) Σ_i Σ_k p(cos θ_i) · Tr(P_i → light_k) · I_k / d².
- * Loops: one march of view_steps, n × lights lookups; no first-hit search, no view marches.
+ * Loops: one march of view_steps (each split into at most LOBE_SUBSTEPS), n × lights lookups; no
+ * first-hit search, no view marches.
  *
  * Emission (-DEMISSION, emission.h): both variants add march_emission over the view ray's segment
  * (`steps` samples), the medium's own light, which neither estimate above holds.
@@ -77,6 +83,9 @@
 
 /* Halvings of the first-hit step: x0 is placed within Δ/64 past the density's zero crossing. */
 #define LOBE_BISECTIONS 6
+
+/* The most sub-steps one corrected view-march step is split into (header comment, C2). */
+#define LOBE_SUBSTEPS 8
 
 /* First parameter in [seg.t0, seg.t1] where the density is above zero (step 1; 0: none), bisected
  * between the last empty sample (or the start of the occupied piece) and the first non-empty one. */
@@ -209,19 +218,28 @@ static inline vec3 lobe_radiance_corrected(KERNEL_CONTEXT_PARAM, NV_PRIVATE cons
   march_iter it = march_begin(KERNEL_CONTEXT_ARG, seg, lp->view_steps);
   *status |= it.status;
   vec3 tau = vec3_splat(0.0f);
-  float w_sum = 0.0f, wt_sum = 0.0f, ws_sum = 0.0f, wst_sum = 0.0f, t;
-  while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
-    const vec3 dtau = vec3_scale(march_sigma_t(KERNEL_CONTEXT_ARG, seg, t), it.delta);
-    const float w = nv_exp(-vec3_average(tau)) * (1.0f - nv_exp(-vec3_average(dtau)));
-    vec3 S = vec3_splat(0.0f);
-    if (w > 0.0f)
-      march_light_sum(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(origin, dir, t), dir, MARCH_LIGHTS_LOBE, &S);
-    const float ws = w * vec3_average(S);
-    w_sum += w;
-    wt_sum += w * t;
-    ws_sum += ws;
-    wst_sum += ws * t;
-    tau = vec3_add(tau, dtau);
+  float w_sum = 0.0f, wt_sum = 0.0f, ws_sum = 0.0f, wst_sum = 0.0f, t_step;
+  while (march_next(&it, KERNEL_CONTEXT_ARG, &t_step)) {
+    /* C2's sub-steps (header comment). */
+    const vec3 dtau_step = vec3_scale(march_sigma_t(KERNEL_CONTEXT_ARG, seg, t_step), it.delta);
+    const float x = it.majorant * vec3_average(medium_sigma_t(m)) * it.delta;
+    const int subs = x > 1.0f ? (int)nv_fmin(x + 1.0f, (float)LOBE_SUBSTEPS) : 1;
+    const float sub = it.delta / (float)subs;
+    for (int j = 0; j < subs; ++j) {
+      const float t = subs == 1 ? t_step : t_step + ((float)j + 0.5f - 0.5f * (float)subs) * sub;
+      const vec3 dtau = subs == 1 ? dtau_step : vec3_scale(march_sigma_t(KERNEL_CONTEXT_ARG, seg, t), sub);
+      const float w = nv_exp(-vec3_average(tau)) * (1.0f - nv_exp(-vec3_average(dtau)));
+      vec3 S = vec3_splat(0.0f);
+      if (w > 0.0f)
+        march_light_sum(KERNEL_CONTEXT_ARG, mp, lc, light_cache, vec3_madd(origin, dir, t), dir, MARCH_LIGHTS_LOBE,
+                        &S);
+      const float ws = w * vec3_average(S);
+      w_sum += w;
+      wt_sum += w * t;
+      ws_sum += ws;
+      wst_sum += ws * t;
+      tau = vec3_add(tau, dtau);
+    }
     if (nv_fmin(tau.x, nv_fmin(tau.y, tau.z)) > tau_limit) break;
   }
   if (!(w_sum > 0.0f)) {

@@ -48,6 +48,7 @@ typedef struct march_iter {
   float a, b;     /* current occupied piece [a, b] */
   float s_a;      /* compressed position of a */
   float delta;    /* step length, world units */
+  float majorant; /* the current piece's majorant density (1 for a whole segment) */
   int k, steps;
   int whole;      /* no majorant grid (host without bounds): the segment is one piece */
   uint status;    /* the first walk's DDA status (majorant_iter.status); callers OR it into theirs.
@@ -57,16 +58,16 @@ typedef struct march_iter {
 /* Next occupied piece of the walk into [*a, *b]; 0 when none is left. */
 static inline int march_next_piece(NV_PRIVATE march_iter* it, KERNEL_CONTEXT_PARAM, NV_PRIVATE float* a,
                                    NV_PRIVATE float* b) {
-  float mx;
   if (it->whole) {
     if (!(it->dda.t < it->dda.t_end)) return 0;
     *a = it->dda.t;
     *b = it->dda.t_end;
     it->dda.t = it->dda.t_end;
+    it->majorant = 1.0f;
     return 1;
   }
-  while (majorant_iter_next(&it->dda, GRID_MAJORANTS, a, b, &mx))
-    if (mx > 0.0f) return 1;
+  while (majorant_iter_next(&it->dda, GRID_MAJORANTS, a, b, &it->majorant))
+    if (it->majorant > 0.0f) return 1;
   return 0;
 }
 
@@ -85,7 +86,7 @@ static inline march_iter march_begin(KERNEL_CONTEXT_PARAM,
   float a, b, len = 0.0f;
   while (march_next_piece(&probe, KERNEL_CONTEXT_ARG, &a, &b)) len += b - a;
   it.status = probe.dda.status;
-  it.a = it.b = it.s_a = 0.0f;
+  it.a = it.b = it.s_a = it.majorant = 0.0f;
   it.steps = steps > 0 ? steps : 1;
   it.delta = len / (float)it.steps;
   it.k = 0;
