@@ -41,7 +41,10 @@ out.mkdir(parents=True, exist_ok=True)
 
 
 def render(scene, algorithm, resolution, name, *sets):
-    """Renders into OUT/NAME.exr; its stats."""
+    """Renders into OUT/NAME.exr; its stats. The lobe is Eq. 7, what frames and tuning measure, unless a set
+    names the variant."""
+    if algorithm == "lobe" and not any(s.startswith("renderer.lobe.variant=") for s in sets):
+        sets = ('renderer.lobe.variant="eq7"',) + sets
     return b.render(a, scene, "--algorithm", algorithm, "--resolution", resolution, "--frames", a.frames,
                     sets=sets, out=out / (name + ".exr"))
 

@@ -188,7 +188,7 @@ bool isRealtime(Algorithm a);
 bool algorithmFromName(const std::string& name, Algorithm* out);
 
 struct LobeSettings {
-  LobeVariant variant = LobeVariant::Eq7;
+  LobeVariant variant = LobeVariant::Corrected;  // eq7: the dissertation's, as it records it
   float depthFactor = 20.0f;
   int lobePoints = 30;
   float lobeRadius = 1.0f;       // eq7: world units; corrected: mean free paths of unit density

@@ -57,7 +57,7 @@ std::vector<SceneKey> sceneKeyTable() {
       {{"resolution", {8, 8}},
        {"algorithm", "raymarch"},
        {"raymarch", {{"multipleScattering", "cache"}, {"msCache", {{"layout", "view"}}}}},
-       {"lobe", {{"variant", "corrected"}}}},
+       {"lobe", {{"variant", LobeSettings{}.variant == LobeVariant::Eq7 ? "corrected" : "eq7"}}}},  // not the default
   };
   std::map<std::string, SceneKey> table;
   for (const json& renderer : renderers) {

@@ -37,7 +37,7 @@
  * view_steps + lights × (one cache lookup or a march of shadow_steps)): all bounded by the scene's
  * parameters; the only open-ended walk is the DDA under each march, capped by its budget (majorant_dda.h).
  *
- * Corrected (renderer.lobe.variant "corrected"; "eq7", the default, is all of the above, bit for bit)
+ * Corrected (renderer.lobe.variant "corrected", the default; "eq7" is all of the above, bit for bit)
  * keeps the idea (HG-distributed points about a point inside the medium past the view ray's entry, their
  * light averaged) and changes what the measurements showed wrong:
  * C1. Eq. 7's in-scattered term ignores how much the medium scatters (a wisp of density 1e-6 gets a dense

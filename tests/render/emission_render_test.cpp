@@ -89,7 +89,7 @@ TEST(EmissionRender, AbsorbingSlabGivesLeTimesOneMinusTransmittance) {
       const double ell = k.depth / pixelCosine(cam, x, y);
       return Le[c] * (1 - std::exp(-k.sa[c] * ell));
     };
-    for (const char* renderer : {"raymarch", "lobe", "lobe+corrected"}) {
+    for (const char* renderer : {"raymarch", "lobe+eq7", "lobe+corrected"}) {
       const RenderResult r = renderWith(scene, renderer);
       ASSERT_EQ(r.stats.status, 0u) << renderer;
       for (int y = 0; y < 16; ++y)
@@ -122,7 +122,7 @@ TEST(EmissionRender, ExtremeAbsorptionKeepsTheSlabsValue) {
       const double Le[3] = {3, 1.5, 0.75};
       return -Le[c] * std::expm1(-sa / pixelCosine(cam, x, y));
     };
-    for (const char* renderer : {"raymarch", "lobe", "lobe+corrected", "pathtrace"}) {
+    for (const char* renderer : {"raymarch", "lobe+eq7", "lobe+corrected", "pathtrace"}) {
       const RenderResult r = renderWith(scene, renderer);
       ASSERT_EQ(r.stats.status, 0u) << renderer << " σa " << sa;
       const bool pathtrace = std::string(renderer) == "pathtrace";
@@ -171,7 +171,7 @@ TEST(EmissionRender, DeepInsideAnEmittingScatteringMediumLApproachesLe) {
     expectTilesWithinNoise(renderWith(scene(K), "pathtrace"), [&](int, int, int c) { return Le[c] * share; },
                            "pathtrace, " + std::to_string(K) + " bounces");
   }
-  for (const char* renderer : {"raymarch", "lobe", "lobe+corrected"}) {
+  for (const char* renderer : {"raymarch", "lobe+eq7", "lobe+corrected"}) {
     const RenderResult r = renderWith(scene(40), renderer);
     ASSERT_EQ(r.stats.status, 0u) << renderer;
     for (int y = 0; y < 16; ++y)
@@ -212,7 +212,7 @@ TEST(EmissionRender, WithoutAbsorptionNothingIsEmittedAndTheFurnaceHolds) {
   const RenderResult pt = renderWith(emitting, "pathtrace");
   ASSERT_EQ(pt.stats.status, 0u);
   for (float v : pt.image.rgb) ASSERT_EQ(v, 1.0f);
-  for (const char* renderer : {"raymarch", "lobe", "lobe+corrected"}) {
+  for (const char* renderer : {"raymarch", "lobe+eq7", "lobe+corrected"}) {
     const RenderResult a = renderWith(emitting, renderer), b = renderWith(scene(false), renderer);
     EXPECT_TRUE(a.image.rgb == b.image.rgb) << renderer;
   }

@@ -153,7 +153,7 @@ TEST(HardCasesGeometry, CameraInsideVolumeRaymarchAndLobeAreBeerLambertToExit) {
   const Scene scene = sceneFromJson(
       insideScene(R"({"resolution": [9, 7], "lobe": {"depthFactor": 1000, "lobeRadius": 0}})"));
   const scene_params sp = buildDeviceScene(scene, nullptr).params;
-  for (const char* algo : {"raymarch", "lobe", "lobe+corrected"}) {
+  for (const char* algo : {"raymarch", "lobe+eq7", "lobe+corrected"}) {
     const RenderResult r = renderWith(scene, algo);
     expectSane(r, 9, 7, algo);
     double worst = 0;
@@ -305,7 +305,7 @@ TEST(HardCasesGeometry, RotatedBoxRaymarchAndLobeMatchAnalyticChord) {
     // The host slab test agrees with the closed form (checks the chord derivation and convention).
     EXPECT_NEAR(boxLength(sp.medium.world_to_index, pixelRay(sp.camera, 2.5, 2.5)), d, 1e-5) << rc.rotation;
     const double expected = std::exp(-kRotSigma * d);
-    for (const char* algo : {"raymarch", "lobe", "lobe+corrected"}) {
+    for (const char* algo : {"raymarch", "lobe+eq7", "lobe+corrected"}) {
       const RenderResult r = renderWith(scene, algo);
       expectSane(r, 5, 5, std::string(algo) + " rotation " + rc.rotation);
       for (int ch = 0; ch < 3; ++ch)
@@ -471,7 +471,7 @@ TEST(HardCasesGeometry, OneVoxelGridRaymarchAndLobeMatchQuadrature) {
   const scene_params sp = buildDeviceScene(scene, &g).params;
   const double centre = voxelTransmittance(g, sp.medium.world_to_index, pixelRay(sp.camera, 2.5, 2.5));
   EXPECT_NEAR(centre, std::exp(-kVoxelSigma * 2 * 0.75), 1e-6);  // the closed form above
-  for (const char* algo : {"raymarch", "lobe", "lobe+corrected"}) {
+  for (const char* algo : {"raymarch", "lobe+eq7", "lobe+corrected"}) {
     const RenderResult r = renderWith(scene, algo, &g);
     expectSane(r, 5, 5, algo);
     for (int py = 0; py < 5; ++py)

@@ -21,8 +21,10 @@
 namespace narval::test {
 namespace {
 
+// Eq. 7, the variant these tests derive (the corrected one: lobe_corrected_test.cpp).
 RenderResult renderLobe(Scene scene, const DenseGrid* grid = nullptr, int lx = 8, int ly = 8) {
   scene.renderer.algorithm = Algorithm::Lobe;
+  scene.renderer.lobe.variant = LobeVariant::Eq7;
   RenderOptions o;
   o.localSizeX = lx;
   o.localSizeY = ly;
@@ -239,7 +241,7 @@ const char* const kEquation7Scene = R"({
     "camera": {"position": [0.3, 0.2, -6], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 60},
     "renderer": {"resolution": [9, 7], "seed": 7,
                  "lightCache": {"resolution": 0},
-                 "lobe": {"depthFactor": 3, "lobePoints": 16, "lobeRadius": 0.8, "shadowSteps": 100,
+                 "lobe": {"variant": "eq7", "depthFactor": 3, "lobePoints": 16, "lobeRadius": 0.8, "shadowSteps": 100,
                           "viewSteps": 100, "minTransmittance": 0}},
     "background": [0.2, 0.3, 0.4]
   })";

@@ -47,11 +47,11 @@ inline RenderResult renderAlgorithm(const Scene& scene, SceneGrids grid = {}) {
 // camera; "raymarch+ms-cache-view" the view layout, columns of 2x2 pixels, 4 slices, with the
 // rectangles' shadows weighted by the phase; "raymarch+ms-cache-direct" the same holding the
 // lights' unscattered light too, no light loop, its paths allocated perceptually over the columns)
-// and the corrected Lobe Estimator (its phase exact as well).
+// and the Lobe Estimator as Eq. 7 ("lobe+eq7") and corrected (its phase exact as well).
 inline const char* const kHardCaseRenderers[] = {"pathtrace",         "raymarch",
                                                  "raymarch+octaves",  "raymarch+ms-cache",
                                                  "raymarch+ms-cache-camera", "raymarch+ms-cache-view",
-                                                 "raymarch+ms-cache-direct", "lobe",
+                                                 "raymarch+ms-cache-direct", "lobe+eq7",
                                                  "lobe+corrected"};
 
 // `scene` rendered by one of kHardCaseRenderers (or any algorithm name), one frame for the
@@ -80,6 +80,9 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGr
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Octaves;
     scene.renderer.raymarch.octaves = 3;
     scene.renderer.raymarch.areaLightSamples = 2;  // and the phase at 2x2 points of a rectangle
+  } else if (renderer == "lobe+eq7") {
+    scene.renderer.algorithm = Algorithm::Lobe;
+    scene.renderer.lobe.variant = LobeVariant::Eq7;
   } else if (renderer == "lobe+corrected") {
     scene.renderer.algorithm = Algorithm::Lobe;
     scene.renderer.lobe.variant = LobeVariant::Corrected;

@@ -198,7 +198,7 @@ TEST(SceneDefaults, ExtensionsAreRead) {
   j["renderer"].update(json::parse(R"({"spp": 16.0, "bounces": 0, "HDR": false, "toneMapping": "reinhard",
       "exposure": -1.5, "algorithm": "lobe", "seed": 4294967295,
       "raymarch": {"steps": 7, "shadowSteps": 3},
-      "lobe": {"depthFactor": 0, "lobePoints": 5, "lobeRadius": 0.25, "shadowSteps": 9}})"));
+      "lobe": {"variant": "eq7", "depthFactor": 0, "lobePoints": 5, "lobeRadius": 0.25, "shadowSteps": 9}})"));
   j["background"] = {0.05, 0.07, 0.1};
   const Scene s = parseScene(j.dump(), "s.json");
   // Read all the same; the medium has no "path", which the two grid keys are told about, and the
@@ -650,7 +650,7 @@ TEST(SceneKeyTable, EveryKeyTypedWithItsDefaultsAndRange) {
   for (const SceneKey& k : table) EXPECT_FALSE(k.type.empty()) << k.key;
   EXPECT_EQ(find("renderer.spp").defaults, std::vector<json>{1000});
   EXPECT_EQ(find("renderer.spp").range, ">= 1");
-  EXPECT_EQ(find("renderer.lobe.viewSteps").defaults, (std::vector<json>{24, 16}));
+  EXPECT_EQ(find("renderer.lobe.viewSteps").defaults, (std::vector<json>{16, 24}));  // corrected's (the default), eq7's
   EXPECT_EQ(find("materials[].g").range, "[-1, 1]");
   EXPECT_EQ(find("materials[].phaseFunction").range, "isotropic, hg, mie");
   EXPECT_TRUE(find("camera.position").required);
