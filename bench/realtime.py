@@ -165,7 +165,7 @@ METHODS = [("raymarch, single scattering", ["--algorithm", "raymarch", "--set",
 def methods():
     refs, resolution = Path(a.refs or out / "references"), a.resolutions.split()[0]
     refs.mkdir(parents=True, exist_ok=True)
-    b.header("scene", "method", "ms/frame", "cache build s", "mean ΔE76", "JND76%")
+    b.header("scene", "method", "ms/frame", "cache build s", "mean ΔE76", "JND76%", "FLIP")
     tiles = []
     for scene in a.scenes.split():
         name = b.scene_name(scene)
@@ -178,10 +178,10 @@ def methods():
             exr = out / ("%s_%d.exr" % (name, index))
             s = b.render(a, scene, "--resolution", resolution, "--frames", a.frames, "--seed", 1,
                          *(options or CACHE_PICKS[name]), out=exr)
-            c, ms = b.compare(a, ref, exr), s["ms_per_frame"]["median"]
+            c, ms, flip = b.compare(a, ref, exr), s["ms_per_frame"]["median"], b.flip([(ref, exr)])[0]
             build = s["ms_cache_ms"] / 1e3 if s.get("ms_cache_builds", 0) > 0 else None
             b.row(name, method, "%.1f" % ms, "" if build is None else "%.1f" % build, "%.2f" % c["mean_dE76"],
-                  "%.1f" % c["jnd76_pct"])
+                  "%.1f" % c["jnd76_pct"], "%.4f" % flip)
             tiles[-1].append((exr.with_suffix(".png"), "%.0f ms%s, dE %.2f, JND %.1f%%" % (
                 ms, "" if build is None else " + %.0f s build" % build, c["mean_dE76"], c["jnd76_pct"])))
     b.montage(tiles, a.picture, ["path tracer (reference)"] + [m for m, _ in METHODS])

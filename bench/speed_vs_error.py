@@ -148,10 +148,12 @@ def row_of(scene, method, parameter, value, parameters, base, seconds, build, co
            "value": value, "seconds": seconds, "build_seconds": build,
            "configuration": method + "_" + "_".join(k + text(v) for k, v in sorted(parameters.items())),
            "settings": settings, "parameters": parameters, "is_base": parameters == base}
-    row.update({k: comparison[k] for k in ("mean_dE76", "jnd76_pct", "mean_dE2000", "jnd2000_pct", "p95_dE76")})
+    row.update({k: comparison[k]
+                for k in ("mean_dE76", "jnd76_pct", "mean_dE2000", "jnd2000_pct", "p95_dE76", "flip")})
     build_text = "  build %6.2f s" % build if build is not None else ""
-    print("  %-23s %-22s %-5s %10s%s  mean ΔE76 %6.2f  JND76 %6.2f%%" % (method, parameter, text(value),
-          time_text(row), build_text, row["mean_dE76"], row["jnd76_pct"]), flush=True)
+    print("  %-23s %-22s %-5s %10s%s  mean ΔE76 %6.2f  JND76 %6.2f%%  FLIP %.4f" % (
+        method, parameter, text(value), time_text(row), build_text, row["mean_dE76"], row["jnd76_pct"], row["flip"]),
+        flush=True)
     return row
 
 
@@ -165,6 +167,10 @@ def pathtrace_rows(a, scene, ref, folder, base):
                                 "--" + fixed, base[fixed], "--reference", ref["exr"], "--resolution", a.resolution,
                                 "--seed", TEST_SEED] + (["--device", a.device] if a.device else []))
         measured = {r["value"]: r for r in json.loads((out / "sweep.json").read_text())["rows"]}
+        flips = b.flip([(ref["exr"], out / (("spp_%05d" if parameter == "spp" else "bounces_%04d") % v + ".exr"))
+                        for v in values])  # the sweep's file names (host/analysis/sweep.cpp, sweepFileName)
+        for value, f in zip(values, flips):
+            measured[value]["flip"] = f
         for value in values:
             parameters = dict(base, **{parameter: value})
             r = measured[value]
@@ -191,7 +197,8 @@ def realtime_rows(a, scene, ref, folder, method, base):
                 s = b.render(a, scene["path"], "--algorithm", algorithm, "--resolution", a.resolution,
                              "--seed", TEST_SEED, "--frames", a.frames, out=out, sets=sets)
                 build = s.get("ms_cache_ms", 0.0) / 1e3 if settings.get("multipleScattering") == "cache" else None
-                measured[key] = (b.seconds(s), build, b.compare(a, ref["exr"], out))
+                comparison = dict(b.compare(a, ref["exr"], out), flip=b.flip([(ref["exr"], out)])[0])
+                measured[key] = (b.seconds(s), build, comparison)
             rows.append(row_of(scene, method, parameter, value, parameters, base, *measured[key]))
     return rows
 
@@ -315,7 +322,7 @@ def run(a):
               "wall_seconds": time.monotonic() - started}
     (out / "results.json").write_text(json.dumps({"run": header, "scenes": scenes, "results": rows}, indent=2))
     columns = ["scene", "method", "algorithm", "parameter", "value", "seconds", "build_seconds", "mean_dE76",
-               "jnd76_pct", "mean_dE2000", "jnd2000_pct"]
+               "jnd76_pct", "mean_dE2000", "jnd2000_pct", "flip"]
     with open(out / "results.csv", "w", newline="") as f:
         csv.writer(f).writerows([columns] + [["" if r[c] is None else r[c] for c in columns] for r in rows])
     print("wrote %s/results.json and results.csv in %.0f s" % (out, header["wall_seconds"]), flush=True)
