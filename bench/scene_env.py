@@ -140,25 +140,21 @@ def compare(a, reference, test, *options):
     return run_json(a.narval, ["compare", reference, test, "--json"] + list(options))
 
 
-FLIP_VENV = REPO / "build" / "flip-venv"
-FLIP_PACKAGES = ["flip-evaluator==1.7", "numpy"]
-FLIP_SCRIPT = """import sys, flip_evaluator as flip
-for ref, test in zip(sys.argv[1::2], sys.argv[2::2]):
-    print(flip.evaluate(ref, test, "HDR")[1])"""
+FLIP_VENV, FLIP_PACKAGES = REPO / "build" / "flip-venv", ["flip-evaluator==1.7", "numpy"]
 
 
 def flip(pairs):
-    """Mean HDR-FLIP (NVIDIA's flip-evaluator from PyPI, its default viewing conditions) of each (reference,
-    test) pair of EXRs, as papers report it. It runs in bench's own environment, build/flip-venv, made here
-    on first use: FLIP is never a build or test dependency."""
+    """Mean HDR-FLIP (flip-evaluator's default viewing conditions) of each (reference, test) pair of EXRs, in
+    build/flip-venv, made on first use: FLIP is never a build or test dependency."""
     python = FLIP_VENV / "bin" / "python"
     if not python.exists():
-        print("making %s for FLIP (%s)" % (FLIP_VENV, ", ".join(FLIP_PACKAGES)), file=sys.stderr)
         subprocess.run([sys.executable, "-m", "venv", str(FLIP_VENV)], check=True)
-        subprocess.run([str(FLIP_VENV / "bin" / "pip"), "install", "--quiet", "--disable-pip-version-check"] +
-                       FLIP_PACKAGES, check=True)
-    args = [str(p) for pair in pairs for p in pair]
-    out = subprocess.run([str(python), "-c", FLIP_SCRIPT] + args, check=True, capture_output=True, text=True)
+        subprocess.run([str(FLIP_VENV / "bin" / "pip"), "install", "-q", "--disable-pip-version-check"] + FLIP_PACKAGES,
+                       check=True)
+    script = ("import sys, flip_evaluator as f\n"
+              "for r, t in zip(sys.argv[1::2], sys.argv[2::2]): print(f.evaluate(r, t, 'HDR')[1])")
+    out = subprocess.run([str(python), "-c", script] + [str(p) for pair in pairs for p in pair], check=True,
+                         capture_output=True, text=True)
     return [float(v) for v in out.stdout.split()]
 
 
