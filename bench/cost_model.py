@@ -20,9 +20,7 @@ import scene_env as b
 p = b.parser(__doc__)
 p.add_argument("--quick", action="store_true")
 p.add_argument("--reps", type=int, help="repetitions (default 3; --quick 1)")
-p.add_argument("--out", default="build/cost_model")
-p.add_argument("--scene", default="scenes/cloud.json")
-p.add_argument("--algorithms", default="pathtrace raymarch")
+b.options(p, out="build/cost_model", scene="scenes/cloud.json", algorithms="pathtrace raymarch")
 a = b.parse(p)
 out = Path(a.out)
 BASE = {"pathtrace": ("160x80", 16), "raymarch": ("320x160", None)}
@@ -209,8 +207,7 @@ def print_report(meta, series_):
         b.row(algorithm, factor, "%s – %s" % (fmt_x(factor, xs[0]), fmt_x(factor, xs[-1])), len(pts), fitted(fk),
               "%.4f" % fk["r2"], fitted(fc), "%.4f" % fc["r2"])
     print("\nPath-tracer work per sample (`--counters`), exponents of the same fit; CPU ns per lookup:\n")
-    b.header("factor", "tentative/sample b", "real/sample b", "lookups/sample b",
-             "CPU ns per lookup (first → last)")
+    b.header("factor", "tentative/sample b", "real/sample b", "lookups/sample b", "CPU ns per lookup (first → last)")
     for (algorithm, factor), pts in series_.items():
         if all(q["cnt"] for q in pts):
             xs, ns = [q["x"] for q in pts], [q["work"] / q["cnt"]["lookups_total"] * 1e9 for q in pts]

@@ -11,10 +11,7 @@ import time
 import scene_env as b
 
 p = b.parser(__doc__, device=False)
-p.add_argument("--scene", default="scenes/disney_cloud.json")
-p.add_argument("--resolution", default="1200x600")
-p.add_argument("--spp", type=int, default=16)
-p.add_argument("--tasks", default="1 2 4 8")
+b.options(p, scene="scenes/disney_cloud.json", resolution="1200x600", spp=16, tasks="1 2 4 8")
 a = b.parse(p)
 NUMBER = r"([\d.e+-]+)"
 
@@ -34,8 +31,7 @@ def measure():
     start = time.monotonic()
     plain = b.render(a, a.scene, *size, out=a.work / "plain.exr")
     plain_seconds = time.monotonic() - start
-    b.header("K", "total s", "over plain", "tasks' walls s", "fixed s per task (mean)", "merge s",
-             "ΔE76 vs plain")
+    b.header("K", "total s", "over plain", "tasks' walls s", "fixed s per task (mean)", "merge s", "ΔE76 vs plain")
     b.row("plain render", "%.1f" % plain_seconds, "1.00", "", "", "", "")
     for k in map(int, a.tasks.split()):
         out = a.work / ("farm_%d.exr" % k)

@@ -19,9 +19,7 @@ p = b.parser(__doc__)
 p.add_argument("experiment", choices=DEFAULTS)
 p.add_argument("--scenes", help="default: the experiment's")
 p.add_argument("--resolution")
-p.add_argument("--spp", type=int, default=16)
-p.add_argument("--frames", type=int, default=5)
-p.add_argument("--reps", type=int, default=3)
+b.options(p, spp=16, frames=5, reps=3)
 p.add_argument("--algorithms")
 a = b.parse(p)
 scenes, resolution, algorithms, names = DEFAULTS[a.experiment]
@@ -42,13 +40,11 @@ def pairs():
         m.pop("emission", None)
     no_emission.write_text(json.dumps(fire, indent=2))
     atexit.register(no_emission.unlink, True)
-    fire = ("scenes/fire.json", [], None)
-    result = [("fire: emitting / emission removed", fire, (no_emission, [], None), False)]
+    result = [("fire: emitting / emission removed", ("scenes/fire.json", [], None), (no_emission, [], None), False)]
     for s in a.scenes.split():
         k = next(i for i, m in enumerate(json.loads(Path(s).read_text())["materials"]) if m["type"] == "volume")
         code_on = ["--set", 'materials[%d].emission={"color":[0,0,0]}' % k]
-        label = "%s: emission code on (Le = 0) / specialised" % s
-        result.append((label, (s, code_on, None), (s, [], None), False))
+        result.append(("%s: emission code on (Le = 0) / specialised" % s, (s, code_on, None), (s, [], None), False))
     return result
 
 

@@ -10,12 +10,7 @@ from pathlib import Path
 import scene_env as b
 
 p = b.parser(__doc__)
-p.add_argument("--resolution", type=int, default=1024)
-p.add_argument("--seed", type=int, default=1)
-p.add_argument("--image", default="160x90")
-p.add_argument("--spp", type=int, default=4)
-p.add_argument("--frames", type=int, default=3)
-p.add_argument("--storages", default="auto bricks")
+b.options(p, resolution=1024, seed=1, image="160x90", spp=4, frames=3, storages="auto bricks")
 a = b.parse(p)
 
 

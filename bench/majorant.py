@@ -6,12 +6,8 @@ import statistics
 import scene_env as b
 
 p = b.parser(__doc__)
-p.add_argument("--scenes", default="scenes/disney_cloud.json scenes/cloud.json")
-p.add_argument("--resolution", default="160x80")
-p.add_argument("--spp", type=int, default=16)
-p.add_argument("--reps", type=int, default=3)
-p.add_argument("--cells", default="8 16 32 64")
-p.add_argument("--frames", type=int, default=5)
+b.options(p, scenes="scenes/disney_cloud.json scenes/cloud.json", resolution="160x80", spp=16, reps=3,
+          cells="8 16 32 64", frames=5)
 a = b.parse(p)
 
 

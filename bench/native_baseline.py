@@ -12,8 +12,7 @@ p = b.parser(__doc__)
 p.add_argument("scene", nargs="?")
 p.add_argument("--resolution")
 p.add_argument("--spp", type=int)
-p.add_argument("--frames", type=int, default=6)
-p.add_argument("--reps", type=int, default=3)
+b.options(p, frames=6, reps=3)
 p.add_argument("--threads", type=int)
 p.add_argument("--algorithms", default="pathtrace raymarch")
 p.add_argument("--set", action="append", default=[], help="PATH=VALUE, to both renderers (repeatable)")
@@ -77,8 +76,7 @@ def measure_case(scene, algorithm, resolution, spp):
     cpu_native, compared = [r[2] for r in runs["native"]], runs["native"][-1][3]
     de = b.compare(a, a.work / (tag + "-pocl.exr"), a.work / (tag + "-native.exr"), *b.LINEAR)["mean_dE76"]
     m = statistics.median
-    samples = ", %d spp" % pocl["spp"] if algorithm == "pathtrace" else ""
-    size = "%dx%d%s" % (pocl["width"], pocl["height"], samples)
+    size = "%dx%d%s" % (pocl["width"], pocl["height"], ", %d spp" % pocl["spp"] if algorithm == "pathtrace" else "")
     cells = [scene, algorithm, size, "%.3f" % m(kernel), "%.3f" % m(wall), "%.3f" % m(times["native"]),
              "**%.2f**" % (m(kernel) / m(times["native"])), "%.2f" % (min(kernel) / min(times["native"])),
              "%.2f" % ((m(cpu_pocl) - base_pocl) / (m(cpu_native) - base_native))]

@@ -13,11 +13,7 @@ DEFAULT_SCENES = "scenes/cloud.json,scenes/disney_cloud.json,scenes/disney_cloud
                  "scenes/dragon.json"
 NO_ROULETTE = "--set renderer.pathtrace.shadowRoulette=0"
 p = b.parser(__doc__)
-p.add_argument("--scenes", default=DEFAULT_SCENES)
-p.add_argument("--resolution", default="160x120")
-p.add_argument("--spp", type=int, default=64)
-p.add_argument("--ref-spp", type=int, default=4096)
-p.add_argument("--reps", type=int, default=3)
+b.options(p, scenes=DEFAULT_SCENES, resolution="160x120", spp=64, ref_spp=4096, reps=3)
 p.add_argument("--configs", default="", help="NAME=narval options;NAME=options (default: the sampling choices)")
 p.add_argument("--cache", default="build/bench-cache")
 p.add_argument("--json", default="", help="also write every measurement to this file")

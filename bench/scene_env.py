@@ -101,6 +101,12 @@ def parser(doc, device=True):
     return p
 
 
+def options(p, **defaults):
+    """Adds an option --NAME (underscores as dashes) per keyword, of its default's type and value."""
+    for name, default in defaults.items():
+        p.add_argument("--" + name.replace("_", "-"), type=type(default), default=default)
+
+
 def parse(p, argv=None):
     """Parsed options, run from the repository root with a scratch folder `work` (removed at exit)."""
     a = p.parse_args(argv)
@@ -234,8 +240,7 @@ def montage(rows, out, headers=(), gap=0):
     """Rows of tiles [(a PNG's path or an HxWx3 uint8 array, caption)] as one PNG at out, gap white pixels
     between the columns: the headers on a line over the columns, each caption on a line under its tile."""
     from PIL import Image, ImageDraw
-    tiles = [[Image.fromarray(t) if hasattr(t, "shape") else Image.open(t).convert("RGB") for t, _ in r]
-             for r in rows]
+    tiles = [[Image.fromarray(t) if hasattr(t, "shape") else Image.open(t).convert("RGB") for t, _ in r] for r in rows]
     w, h = tiles[0][-1].size
     if any(t.size != (w, h) for r in tiles for t in r):
         raise NarvalError("%s: tiles of other sizes than %dx%d" % (out, w, h))

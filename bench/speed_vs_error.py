@@ -148,8 +148,7 @@ def row_of(scene, method, parameter, value, parameters, base, seconds, build, co
            "value": value, "seconds": seconds, "build_seconds": build,
            "configuration": method + "_" + "_".join(k + text(v) for k, v in sorted(parameters.items())),
            "settings": settings, "parameters": parameters, "is_base": parameters == base}
-    row.update({k: comparison[k]
-                for k in ("mean_dE76", "jnd76_pct", "mean_dE2000", "jnd2000_pct", "p95_dE76", "flip")})
+    row.update({k: comparison[k] for k in ("mean_dE76", "jnd76_pct", "mean_dE2000", "jnd2000_pct", "p95_dE76", "flip")})
     build_text = "  build %6.2f s" % build if build is not None else ""
     print("  %-23s %-22s %-5s %10s%s  mean ΔE76 %6.2f  JND76 %6.2f%%  FLIP %.4f" % (
         method, parameter, text(value), time_text(row), build_text, row["mean_dE76"], row["jnd76_pct"], row["flip"]),
@@ -170,11 +169,9 @@ def pathtrace_rows(a, scene, ref, folder, base):
         flips = b.flip([(ref["exr"], out / (("spp_%05d" if parameter == "spp" else "bounces_%04d") % v + ".exr"))
                         for v in values])  # the sweep's file names (host/analysis/sweep.cpp, sweepFileName)
         for value, f in zip(values, flips):
-            measured[value]["flip"] = f
-        for value in values:
-            parameters = dict(base, **{parameter: value})
-            r = measured[value]
-            rows.append(row_of(scene, "pathtrace", parameter, value, parameters, base, r["seconds"], None, r))
+            r = dict(measured[value], flip=f)
+            rows.append(row_of(scene, "pathtrace", parameter, value, dict(base, **{parameter: value}), base,
+                               r["seconds"], None, r))
     return rows
 
 
@@ -231,10 +228,9 @@ def summarise(rows, threshold):
         mine = [p for p in points if p["method"] == method]
         if mine:
             within = [p for p in mine if p["jnd76_pct"] <= threshold]
-            fastest = "none under JND %g%%" % threshold
-            if within:
-                fastest = "fastest under JND %g%%: %s" % (threshold, described(min(
-                    within, key=lambda p: (p["seconds"], p["jnd76_pct"]))))
+            fast = min(within, key=lambda p: (p["seconds"], p["jnd76_pct"]), default=None)
+            fastest = ("fastest under JND %g%%: %s" % (threshold, described(fast)) if fast
+                       else "none under JND %g%%" % threshold)
             lines.append("%s: %s; lowest JND: %s" % (method, fastest, described(min(
                 mine, key=lambda p: (p["jnd76_pct"], p["seconds"])))))
     front, best = [], math.inf

@@ -13,8 +13,7 @@ from pathlib import Path
 import scene_env as b
 
 p = b.parser(__doc__)
-p.add_argument("--scenes", default=" ".join(sorted(glob.glob("scenes/*.json", root_dir=b.REPO))))
-p.add_argument("--algorithms", default="raymarch lobe pathtrace")
+b.options(p, scenes=" ".join(sorted(glob.glob("scenes/*.json", root_dir=b.REPO))), algorithms="raymarch lobe pathtrace")
 p.add_argument("--target-ms", type=float, default=50)
 p.add_argument("--out", default="build/viewer_frames")
 a = b.parse(p)

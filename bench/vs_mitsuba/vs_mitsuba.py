@@ -148,9 +148,8 @@ def affine(linear, translation):
 
 def rgb(v, unbounded=False):
     """A constant RGB; `unbounded` lets a coefficient exceed 1 (the srgb plugin itself)."""
-    if unbounded:
-        return {"type": "srgb", "color": [float(x) for x in v], "unbounded": True}
-    return {"type": "rgb", "value": [float(x) for x in v]}
+    v = [float(x) for x in v]
+    return {"type": "srgb", "color": v, "unbounded": True} if unbounded else {"type": "rgb", "value": v}
 
 
 def translate_scene(scene, out_dir):
@@ -252,11 +251,10 @@ def translate_camera(scene, medium_box):
     forward, image x along right, vfov vertical. Mitsuba's camera x points to the image's left: to_world's
     columns are (-right, up', forward, position). A box filter weighs samples uniformly in the pixel."""
     c = scene["camera"]
+    unit = lambda v: v / np.linalg.norm(v)  # noqa: E731
     pos = np.array(c["position"])
-    fwd = np.array(c["lookAt"]) - pos
-    fwd /= np.linalg.norm(fwd)
-    right = np.cross(fwd, np.array(c["up"]))
-    right /= np.linalg.norm(right)
+    fwd = unit(np.array(c["lookAt"]) - pos)
+    right = unit(np.cross(fwd, np.array(c["up"])))
     m = np.eye(4)
     x = right if "mirror" in PERTURB else -right
     m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = x, np.cross(right, fwd), fwd, pos
@@ -277,13 +275,9 @@ def translate_camera(scene, medium_box):
 
 def load_mitsuba_scene(scene, out_dir):
     """The translated scene, loaded (every to_world as a ScalarTransform4f)."""
-    d = translate_scene(scene, out_dir)
-
-    def objects(value):
-        if not isinstance(value, dict):
-            return value
-        return {k: mitsuba().ScalarTransform4f(x) if k == "to_world" else objects(x) for k, x in value.items()}
-    return mitsuba().load_dict(objects(d))
+    objects = lambda v: {k: mitsuba().ScalarTransform4f(x) if k == "to_world" else objects(x)  # noqa: E731
+                         for k, x in v.items()} if isinstance(v, dict) else v
+    return mitsuba().load_dict(objects(translate_scene(scene, out_dir)))
 
 
 # ---- rendering ---------------------------------------------------------------------------------------
@@ -355,18 +349,14 @@ def region_stats(mean, var, sl):
 def compare_images(narval_imgs, mitsuba_imgs):
     """z of the image-mean difference per channel, and chi^2 of the TILES x TILES tiles' mean
     differences (one degree of freedom per tile that sees noise: q = the mean over RGB of z^2)."""
-    stats = []
-    for imgs in (narval_imgs, mitsuba_imgs):  # per-pixel mean over the K renders, variance of that mean
-        imgs = np.asarray(imgs, dtype=np.float64)
-        stats.append((imgs.mean(axis=0), imgs.var(axis=0, ddof=1) / imgs.shape[0]))
-    (mn, vn), (mm, vm) = stats
-    h, w = mn.shape[:2]
-    mean_n, var_n = region_stats(mn, vn, np.s_[:, :])
-    mean_m, var_m = region_stats(mm, vm, np.s_[:, :])
+    # Per pixel, the mean over the K renders and the variance of that mean.
+    per_pixel = lambda imgs: (imgs.mean(axis=0), imgs.var(axis=0, ddof=1) / imgs.shape[0])  # noqa: E731
+    (mn, vn), (mm, vm) = (per_pixel(np.asarray(i, dtype=np.float64)) for i in (narval_imgs, mitsuba_imgs))
+    (mean_n, var_n), (mean_m, var_m) = region_stats(mn, vn, np.s_[:, :]), region_stats(mm, vm, np.s_[:, :])
     tol = NUMERIC_TOLERANCE * np.maximum(abs(mean_n), abs(mean_m))
     se = np.sqrt(var_n + var_m + tol ** 2)
     z = [float(x) for x in np.where(se > 0, (mean_n - mean_m) / np.where(se > 0, se, 1), 0.0)]
-    ys, xs = (np.linspace(0, n, TILES + 1).round().astype(int) for n in (h, w))
+    ys, xs = (np.linspace(0, n, TILES + 1).round().astype(int) for n in mn.shape[:2])
     chi2, dof, worst = 0.0, 0, None
     for j in range(TILES):
         for i in range(TILES):
@@ -438,8 +428,7 @@ def reference(scene_path, scene, res, ref_spp, narval):
             st = os.stat(m["path"])
             h.update(("%s:%d:%d" % (os.path.abspath(m["path"]), st.st_size, int(st.st_mtime))).encode())
     h.update(("%dx%d:%d:%d" % (res[0], res[1], scene["bounces"], ref_spp)).encode())
-    name = os.path.splitext(os.path.basename(scene_path))[0]
-    key = "%s_%dx%d_%dspp_%s" % (name, *res, ref_spp, h.hexdigest()[:12])
+    key = "%s_%dx%d_%dspp_%s" % (os.path.splitext(os.path.basename(scene_path))[0], *res, ref_spp, h.hexdigest()[:12])
     cache = os.path.join(WORK_DIR, "reference_cache")
     os.makedirs(cache, exist_ok=True)
     halves = []
@@ -521,12 +510,11 @@ def run_race(args):
     with open(os.path.join(out_dir, "race.json"), "w") as f:
         json.dump(result, f, indent=1)
     lines = ["| renderer | spp | seconds | kernel s | relMSE | relMSE x s |", "|---|---:|---:|---:|---:|---:|"]
-    for name in ("narval", "mitsuba"):
-        for g in summary[name]["rungs"]:
-            lines.append("| %s | %d | %.3f | %.3f | %.3g%s | %s |" % (
-                name, g["spp"], g["seconds"], g["kernel_seconds"], g["rel_mse"],
-                " (ref.-limited)" if g["reference_limited"] else "",
-                "%.3g" % g["rel_mse_x_seconds"] if g["rel_mse_x_seconds"] else "-"))
+    lines += ["| %s | %d | %.3f | %.3f | %.3g%s | %s |" % (
+                  name, g["spp"], g["seconds"], g["kernel_seconds"], g["rel_mse"],
+                  " (ref.-limited)" if g["reference_limited"] else "",
+                  "%.3g" % g["rel_mse_x_seconds"] if g["rel_mse_x_seconds"] else "-")
+              for name in ("narval", "mitsuba") for g in summary[name]["rungs"]]
     fmt = lambda x, f="%.3g": f % x if x else "n/a"  # noqa: E731
     at_rungs = ", ".join("%d spp %.2f" % (x["mitsuba_spp"], x["ratio"]) for x in result["interpolated"])
     lines.append("\nTime at equal relMSE, narval / Mitsuba: **%s** (relMSE x seconds: narval %s, Mitsuba %s; "
