@@ -143,7 +143,8 @@ constexpr uint8_t kJndText[3] = {255, 255, 0};
 }  // namespace
 
 ImageComparison compareImages(const ImageRGB& reference, const ImageRGB& test, const DisplaySettings& display,
-                              const std::string& referenceName, const std::string& testName) {
+                              const std::string& referenceName, const std::string& testName,
+                              const std::vector<uint32_t>* mask) {
   checkBuffer(reference, "compareImages: reference");
   checkBuffer(test, "compareImages: test");
   if (test.width != reference.width || test.height != reference.height)
@@ -163,12 +164,15 @@ ImageComparison compareImages(const ImageRGB& reference, const ImageRGB& test, c
   c.dE2000.resize(n);
   const float scale = exposureScale(display.exposureStops);
   const ToneMapping tm = display.toneMapping;
+  if (mask && mask->size() != n) throw std::invalid_argument("compareImages: the mask's size is not the images'");
+  auto counted = [mask](size_t i) { return !mask || (*mask)[i] != 0; };
   double relMseSum = 0;
   for (size_t k = 0; k < n * 3; ++k) {
+    if (!counted(k / 3)) continue;
     const double r = reference.rgb[k], d = double(test.rgb[k]) - r;
     relMseSum += d * d / (r * r + kRelMseEpsilon);
   }
-  c.relMse = n > 0 ? relMseSum / double(n * 3) : 0.0;
+  std::vector<float> counted76, counted2000;  // the statistics' pixels
   for (size_t i = 0; i < n; ++i) {
     const float* p = &reference.rgb[i * 3];
     const float* q = &test.rgb[i * 3];
@@ -178,9 +182,15 @@ ImageComparison compareImages(const ImageRGB& reference, const ImageRGB& test, c
         linearSrgbToLab(displayLinear(q[0], scale, tm), displayLinear(q[1], scale, tm), displayLinear(q[2], scale, tm));
     c.dE76[i] = float(deltaE76(a, b));
     c.dE2000[i] = float(deltaE2000(a, b));
+    if (mask && counted(i)) {
+      counted76.push_back(c.dE76[i]);
+      counted2000.push_back(c.dE2000[i]);
+    }
   }
-  c.stats76 = statsOf(c.dE76);
-  c.stats2000 = statsOf(c.dE2000);
+  c.pixels = mask ? counted76.size() : n;
+  c.relMse = c.pixels > 0 ? relMseSum / double(c.pixels * 3) : 0.0;
+  c.stats76 = statsOf(mask ? counted76 : c.dE76);
+  c.stats2000 = statsOf(mask ? counted2000 : c.dE2000);
   return c;
 }
 

@@ -22,6 +22,7 @@ struct DeltaEStats {
 struct ImageComparison {
   int width = 0, height = 0;
   std::vector<float> dE76, dE2000;  // per pixel, row 0 at the top
+  size_t pixels = 0;                // those the statistics are over: all, or the mask's
   DeltaEStats stats76, stats2000;
   // Relative mean squared error of the linear values (before the display transform), the error
   // Monte Carlo renderers are raced by (pbrt-v4, Mitsuba 3): the mean over pixels and channels of
@@ -44,9 +45,11 @@ struct DisplaySettings {
 
 // Throws InputError naming `testName` when the sizes differ ("size 10x8 differs from the
 // reference's 12x8") or either image holds NaN/Inf ("… holds 3 non-finite values"), naming the
-// image with the problem.
+// image with the problem. With `mask` (one value per pixel, e.g. render/medium_mask.h's), the
+// statistics and relMSE are over the pixels where it is not 0; dE76 and dE2000 still hold every pixel.
 ImageComparison compareImages(const ImageRGB& reference, const ImageRGB& test, const DisplaySettings& display,
-                              const std::string& referenceName = "reference", const std::string& testName = "test");
+                              const std::string& referenceName = "reference", const std::string& testName = "test",
+                              const std::vector<uint32_t>* mask = nullptr);
 
 // The image as displayed: display transform, then the sRGB curve, 8 bit (as writePng does).
 ImageRGB8 displayImage(const ImageRGB& image, const DisplaySettings& display);

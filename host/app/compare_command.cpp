@@ -2,6 +2,7 @@
 // 95th percentile and max of ΔE76 and ΔE2000 and the JND% (ΔE > 2.3) of each, as a table or as JSON;
 // optionally the ΔE76 heat map and the JND map as PNGs, and the floor the reference's own noise puts
 // under the JND% (--reference-snapshot, host/analysis/reference_noise.h).
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +22,7 @@
 #include "core/input_error.h"
 #include "core/number_format.h"
 #include "image/image.h"
+#include "render/medium_mask.h"
 
 namespace fs = std::filesystem;
 
@@ -33,6 +35,7 @@ struct CompareArgs {
   std::optional<double> exposure;                          // double: the JSON echoes what was typed
   double heatmapMax = 10.0;
   bool json = false;
+  bool mediumOnly = false;  // the statistics over the pixels that see the medium (render/medium_mask.h)
 };
 
 // The display transform both EXRs record (render_exr.h: narval:exposure and narval:tone_mapping,
@@ -69,6 +72,28 @@ void checkPngOutput(const std::string& path, const std::string& option) {
 }
 
 
+// The medium mask for --medium-only: the reference's, else the test's (a path-traced sweep's renders
+// carry none). Both must agree where both have one: two masks that differ are two scenes or cameras.
+std::vector<uint32_t> mediumOnlyMask(const std::string& reference, const std::string& test) {
+  auto maskOf = [](const std::string& path) -> std::optional<std::vector<uint32_t>> {
+    const ExrHeader h = readExrHeader(path);
+    if (std::find(h.channels.begin(), h.channels.end(), kMediumMaskChannel) == h.channels.end()) return std::nullopt;
+    return readExrUintChannels(path, {kMediumMaskChannel})[0].values;
+  };
+  const auto r = maskOf(reference), t = maskOf(test);
+  if (!r && !t)
+    throw inputError("--medium-only", "",
+                     "neither " + reference + " nor " + test + " has a " + kMediumMaskChannel +
+                         " channel (narval render writes it: the pixels that see the medium)");
+  if (r && t && *r != *t)
+    throw inputError(test, kMediumMaskChannel,
+                     "differs from " + reference + "'s: the renders are not of the same scene and camera");
+  const std::vector<uint32_t>& m = r ? *r : *t;
+  if (std::count(m.begin(), m.end(), 0u) == std::ptrdiff_t(m.size()))
+    throw inputError(r ? reference : test, kMediumMaskChannel, "no pixel sees the medium");
+  return m;
+}
+
 std::string tableRow(const char* name, const DeltaEStats& s) {
   char buf[160];
   std::snprintf(buf, sizeof buf, "%-8s %10.4f %10.4f %10.4f %9.2f%%\n", name, s.mean, s.p95, s.max, s.jndPercent);
@@ -91,6 +116,8 @@ int runCompare(const CompareArgs& a) {
 
   const ImageRGB reference = readExr(a.reference);
   const ImageRGB test = readExr(a.test);
+  std::optional<std::vector<uint32_t>> mask;
+  if (a.mediumOnly) mask = mediumOnlyMask(a.reference, a.test);
   std::optional<ReferenceNoise> noise;
   if (!a.snapshot.empty()) noise = estimateReferenceNoise(a.reference, reference, a.snapshot);
   // Flags win; what they leave open comes from the EXRs when both record the same transform.
@@ -107,9 +134,10 @@ int runCompare(const CompareArgs& a) {
   DisplaySettings display;
   display.exposureStops = float(exposure);
   display.toneMapping = toneMapping;
-  const ImageComparison c = compareImages(reference, test, display, a.reference, a.test);
+  const std::vector<uint32_t>* maskPtr = mask ? &*mask : nullptr;
+  const ImageComparison c = compareImages(reference, test, display, a.reference, a.test, maskPtr);
   std::optional<ImageComparison> floor;  // a noise-free image against the reference, estimated
-  if (noise) floor = compareImages(reference, noise->perturbed, display, a.reference, a.snapshot);
+  if (noise) floor = compareImages(reference, noise->perturbed, display, a.reference, a.snapshot, maskPtr);
 
   if (!a.heatmap.empty()) {
     writeDeltaEHeatmap(a.heatmap, c.dE76, c.width, c.height, float(a.heatmapMax));
@@ -122,6 +150,8 @@ int runCompare(const CompareArgs& a) {
     nlohmann::ordered_json j = {{"reference", a.reference}, {"test", a.test},      {"width", c.width},
                                 {"height", c.height},       {"exposure", exposure}, {"tonemap", toneMappingName(toneMapping)},
                                 {"display_transform", source}};
+    j["pixels"] = c.pixels;
+    j["mask"] = mask ? kMediumMaskChannel : "none";
     addDeltaEJson(j, c.stats76, c.stats2000);
     j["rel_mse"] = c.relMse;
     if (floor) {
@@ -137,7 +167,9 @@ int runCompare(const CompareArgs& a) {
   std::cout << "reference " << a.reference << "\n"
             << "test      " << a.test << "\n"
             << "          " << c.width << "x" << c.height << ", exposure " << formatFixed(exposure, 2)
-            << " stops, tone mapping " << toneMappingName(toneMapping) << " (" << source << ")\n\n";
+            << " stops, tone mapping " << toneMappingName(toneMapping) << " (" << source << ")\n";
+  if (mask) std::cout << "          over the " << c.pixels << " pixels that see the medium\n";
+  std::cout << "\n";
   char header[160];
   std::snprintf(header, sizeof header, "%-8s %10s %10s %10s %10s\n", "", "mean", "p95", "max", "JND%");
   std::cout << header << tableRow("dE76", c.stats76) << tableRow("dE2000", c.stats2000)
@@ -174,6 +206,9 @@ Command addCompareCommand(CLI::App& app) {
   sub->add_option("--reference-snapshot", a->snapshot,
                   "An earlier snapshot of REF's path-traced render (its first samples, before --resume "
                   "continued it): also report the JND% that REF's own noise alone would give");
+  sub->add_flag("--medium-only", a->mediumOnly,
+                "Judge only the pixels whose ray meets the medium (the renders' medium channel), so an empty "
+                "background does not dilute the statistics");
   sub->add_flag("--json", a->json, "Print one JSON object instead of the table");
   return {sub, [a]() { return runCompare(*a); }};
 }

@@ -301,7 +301,11 @@ std::map<std::string, std::string> readExrAttributes(const std::string& path) {
 ExrHeader readExrHeader(const std::string& path) {
   auto file = openExr(path);
   const Imath::Box2i window = checkedWindow(path, file->header(), {}, Imf::FLOAT);
-  return {window.max.x - window.min.x + 1, window.max.y - window.min.y + 1, attributesOf(file->header())};
+  std::vector<std::string> channels;
+  for (auto it = file->header().channels().begin(); it != file->header().channels().end(); ++it)
+    channels.push_back(it.name());
+  return {window.max.x - window.min.x + 1, window.max.y - window.min.y + 1, attributesOf(file->header()),
+          std::move(channels)};
 }
 
 }  // namespace narval

@@ -51,10 +51,11 @@ std::map<std::string, std::string> readExrAttributes(const std::string& path);
 // The named channels as 32-bit float, width*height values each in the data window's size; a
 // missing channel throws InputError "PATH: no NAME channel (channels: ...)", like readExr.
 std::vector<ExrChannel> readExrChannels(const std::string& path, const std::vector<std::string>& names);
-// The data window's size and the attributes (as readExrAttributes), from the header alone.
+// The data window's size, the attributes (as readExrAttributes) and the channels' names, from the header alone.
 struct ExrHeader {
   int width = 0, height = 0;
   std::map<std::string, std::string> attributes;
+  std::vector<std::string> channels;
 };
 ExrHeader readExrHeader(const std::string& path);
 // R, G and B (as readExr), the named UINT channels (as readExrUintChannels) and the attributes (as

@@ -8,6 +8,7 @@
 #include "cl/device_allocation.h"
 #include "render/device_scene.h"
 #include "render/majorant_options.h"
+#include "render/medium_mask.h"
 #include "render/render_common.h"
 
 namespace narval {
@@ -138,7 +139,10 @@ void PathtraceRenderer::readBack(RenderResult& into) {
   into.stats.resumedFromSpp = first_;
   into.stats.interrupted = done_ < view_.renderer.spp;
   into.stats.nanPixels = 0;
-  if (done_ > 0) into.image = accumulatorImage(acc, W, H, &into.stats.nanPixels);
+  if (done_ > 0) {
+    into.image = accumulatorImage(acc, W, H, &into.stats.nanPixels);
+    into.mediumMask = mediumMask(dev_.scene);
+  }
   if (options_.counters) {
     std::vector<cl_ulong> counts(pixels * 3);
     rt_.queue.enqueueReadBuffer(counterBuf_, CL_TRUE, 0, counts.size() * sizeof(cl_ulong), counts.data());

@@ -8,6 +8,7 @@
 #include "cl/cl_runtime.h"
 #include "core/input_error.h"
 #include "core/shell_quote.h"
+#include "render/medium_mask.h"
 #include "shared/accum.h"
 
 namespace narval {
@@ -178,6 +179,7 @@ void writeRenderExr(const std::string& path, const RenderResult& r, const Render
       channels.push_back(std::move(ch));
     }
   }
+  if (r.mediumMask.size() == pixels) channels.push_back({kMediumMaskChannel, r.mediumMask});
   writeExr(path, r.image, renderAttributes(r.stats, identity), channels);
 }
 
@@ -194,6 +196,7 @@ RenderPart readRenderPartHeader(const std::string& path) {
   part.width = header.width;
   part.height = header.height;
   part.attributes = std::move(header.attributes);
+  for (const std::string& c : header.channels) part.hasMediumMask = part.hasMediumMask || c == kMediumMaskChannel;
   const auto& attrs = part.attributes;
   const auto algorithm = attrs.find("narval:algorithm");
   if (algorithm == attrs.end() || algorithm->second != "pathtrace")

@@ -63,6 +63,7 @@ struct RenderPart {
   std::map<std::string, std::string> attributes;
   int width = 0, height = 0;
   AccumulatorState accumulator;
+  bool hasMediumMask = false;  // the render/medium_mask.h channel is there (renders before it lack it)
   const std::string& attribute(const std::string& name) const;  // "" when absent
 };
 

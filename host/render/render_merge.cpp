@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "core/input_error.h"
+#include "render/medium_mask.h"
 
 namespace narval {
 
@@ -111,6 +112,8 @@ MergedRender mergeRenderParts(const std::vector<std::string>& paths) {
   st.majorant = first.attribute("narval:majorant");
   st.majorantResolution = std::atoi(first.attribute("narval:majorant_resolution").c_str());
   r.image = accumulatorImage(r.accumulator, first.width, first.height, &st.nanPixels);
+  // Every part renders the same scene and camera (the render key), so the first's mask is theirs.
+  if (first.hasMediumMask) r.mediumMask = readExrUintChannels(first.path, {kMediumMaskChannel})[0].values;
   merged.identity = mergedIdentity(first, st.spp);
   return merged;
 }

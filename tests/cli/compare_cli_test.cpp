@@ -105,8 +105,10 @@ TEST_F(CompareCli, JsonKeysAndValuesOnAConstructedPair) {
   for (const auto& item : j.items()) keys.push_back(item.key());
   std::sort(keys.begin(), keys.end());
   EXPECT_EQ(keys, (std::vector<std::string>{"display_transform", "exposure", "height", "jnd2000_pct", "jnd76_pct",
-                                            "max_dE2000", "max_dE76", "mean_dE2000", "mean_dE76", "p95_dE2000",
-                                            "p95_dE76", "reference", "rel_mse", "test", "tonemap", "width"}));
+                                            "mask", "max_dE2000", "max_dE76", "mean_dE2000", "mean_dE76", "p95_dE2000",
+                                            "p95_dE76", "pixels", "reference", "rel_mse", "test", "tonemap", "width"}));
+  EXPECT_EQ(j["mask"], "none");
+  EXPECT_EQ(j["pixels"], 80);
   EXPECT_NEAR(j["rel_mse"].get<double>() / pairRelMse(1.0), 1.0, 1e-5);
   EXPECT_EQ(j["display_transform"], "the default: the EXRs record no common display transform");
   EXPECT_EQ(j["reference"], "ref.exr");
@@ -114,6 +116,56 @@ TEST_F(CompareCli, JsonKeysAndValuesOnAConstructedPair) {
   EXPECT_EQ(j["exposure"], 0.0);
   EXPECT_EQ(j["tonemap"], "none");
   expectPairJson(j);
+}
+
+// --medium-only judges the pixels of the renders' medium channel (render/medium_mask.h). On the
+// pair above, a mask of its 20 near pixels (ΔE76 116·(∛(0.125·1.030301) − ∛0.125) = 116·0.5·0.01 =
+// 0.58 each) and 8 of its equal ones: mean ΔE76 20·0.58/28, max 0.58, JND 0%, relMSE over 28 pixels.
+// The 12 far pixels (ΔE76 11.6) lie outside it: if they counted, the max would be 11.6.
+TEST_F(CompareCli, MediumOnlyJudgesThePixelsOfTheMediumMask) {
+  writePair("ref.exr", "test.exr", 1.0f);
+  ImageRGB ref = uniform(10, 8, 0.125f);
+  ExrUintChannel mask{"medium", std::vector<uint32_t>(80, 0u)};
+  for (int i = 12; i < 40; ++i) mask.values[size_t(i)] = 1u;
+  writeExr((dir_ / "masked_ref.exr").string(), ref, {}, {mask});
+  const RunResult r = run("compare masked_ref.exr test.exr --medium-only --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["mask"], "medium");
+  EXPECT_EQ(j["pixels"], 28);
+  EXPECT_NEAR(j["mean_dE76"].get<double>(), 20 * 0.58 / 28, 1e-3);
+  EXPECT_NEAR(j["max_dE76"].get<double>(), 0.58, 1e-3);
+  EXPECT_DOUBLE_EQ(j["jnd76_pct"].get<double>(), 0.0);
+  const double near = 0.125 * 0.030301;
+  EXPECT_NEAR(j["rel_mse"].get<double>() / (20 * near * near / (0.125 * 0.125 + 0.01) / 28), 1.0, 1e-5);
+  // Without the flag the mask is not used; the table names the pixels it judged.
+  const RunResult all = run("compare masked_ref.exr test.exr --json");
+  ASSERT_EQ(all.code, 0) << all.err;
+  expectPairJson(nlohmann::json::parse(all.out));
+  const RunResult table = run("compare masked_ref.exr test.exr --medium-only");
+  ASSERT_EQ(table.code, 0) << table.err;
+  EXPECT_NE(table.out.find("over the 28 pixels that see the medium\n"), std::string::npos) << table.out;
+  // The test's own mask serves when the reference has none; two masks must agree.
+  const RunResult swapped = run("compare ref.exr masked_ref.exr --medium-only --json");
+  ASSERT_EQ(swapped.code, 0) << swapped.err;
+  EXPECT_EQ(nlohmann::json::parse(swapped.out)["pixels"], 28);
+  mask.values[0] = 1u;
+  writeExr((dir_ / "other_mask.exr").string(), ref, {}, {mask});
+  const RunResult differ = run("compare masked_ref.exr other_mask.exr --medium-only");
+  EXPECT_EQ(differ.code, 2);
+  EXPECT_EQ(differ.err,
+            "narval: other_mask.exr: medium: differs from masked_ref.exr's: the renders are not of the same scene "
+            "and camera\n");
+  const RunResult none = run("compare ref.exr test.exr --medium-only");
+  EXPECT_EQ(none.code, 2);
+  EXPECT_EQ(none.err,
+            "narval: --medium-only: neither ref.exr nor test.exr has a medium channel (narval render writes it: the "
+            "pixels that see the medium)\n");
+  EXPECT_EQ(none.out, "");
+  writeExr((dir_ / "empty_mask.exr").string(), ref, {}, {ExrUintChannel{"medium", std::vector<uint32_t>(80, 0u)}});
+  const RunResult empty = run("compare empty_mask.exr test.exr --medium-only");
+  EXPECT_EQ(empty.code, 2);
+  EXPECT_EQ(empty.err, "narval: empty_mask.exr: medium: no pixel sees the medium\n");
 }
 
 TEST_F(CompareCli, ExposureAndToneMappingApplyToBoth) {

@@ -1,5 +1,6 @@
 // exr_bits.h: bit-for-bit comparison of EXR channels as stored: R, G and B as 32-bit floats, the
-// path tracer's accumulator channels (accum.*) as 32-bit unsigned ints (render/render_exr.h).
+// path tracer's accumulator channels (accum.*) and the medium mask (medium) as 32-bit unsigned ints
+// (render/render_exr.h, render/medium_mask.h).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -30,16 +31,17 @@ inline long long differingValues(const std::string& a, const std::string& b, con
     for (size_t k = 0; k < x.size(); ++k) n += std::memcmp(&x[k], &y[k], sizeof x[k]) != 0;
     return n;
   };
-  if (name.rfind("accum.", 0) == 0)
+  if (name.rfind("accum.", 0) == 0 || name == "medium")
     return count(readExrUintChannels(a, {name}).at(0).values, readExrUintChannels(b, {name}).at(0).values);
   return count(readExrChannels(a, {name}).at(0).values, readExrChannels(b, {name}).at(0).values);
 }
 
-// Every channel in `names` (default: R, G, B and the accumulator) equal bit for bit.
+// Every channel in `names` (default: R, G, B, the accumulator and the medium mask) equal bit for bit.
 inline void expectSameBits(const std::string& a, const std::string& b, std::vector<std::string> names = {}) {
   if (names.empty()) {
     names = accumulatorChannels();
     names.insert(names.begin(), {"R", "G", "B"});
+    names.push_back("medium");
   }
   for (const std::string& n : names) EXPECT_EQ(differingValues(a, b, n), 0) << a << " and " << b << ": channel " << n;
 }
