@@ -166,13 +166,7 @@ TEST(MajorantRender, EachModeIsDeterministic) {
 // collision, no density lookup, image exactly 1. Global (control): σ̄ = σt·max ρ over the whole box,
 // tentative collisions everywhere (each a lookup), all null: the same image, lookups > 0.
 TEST(MajorantRender, EmptyCellsMakeNoLookups) {
-  DenseGrid grid;
-  grid.nx = grid.ny = grid.nz = 16;
-  grid.data.assign(grid.voxelCount(), 0.0f);
-  for (int z = 0; z < 16; ++z)
-    for (int y = 0; y < 16; ++y)
-      for (int x = 12; x < 16; ++x) grid.data[size_t(x + 16 * (y + 16 * z))] = 1.0f;
-  grid.maxValue = 1.0f;
+  const DenseGrid grid = xSlabGrid(16, 12, 16);
   const Scene scene = sceneFromJson(R"({
     "materials": [{"name": "m", "type": "volume", "scattering": [2, 2, 2], "absorption": [1, 1, 1],
                    "phaseFunction": "isotropic", "density": 1}],

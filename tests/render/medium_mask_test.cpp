@@ -21,6 +21,7 @@ using test::Ray;
 using test::pixelCentreRay;
 using test::renderAlgorithm;
 using test::sceneFromJson;
+using test::xSlabGrid;
 
 // HG, chromatic, no light: the kernels' variant many render tests share (no extra compilation).
 std::string boxScene(const std::string& extra) {
@@ -82,13 +83,7 @@ TEST(MediumMask, AHomogeneousBoxIsThePixelsWhoseRayCrossesIt) {
 // view is nearly parallel: the ray's index x moves by 16·tan(3.5°)·(28/16)/2 < 0.9 through the box,
 // checked at its entry and exit). A mirrored mask fails the second half.
 TEST(MediumMask, AGridIsMaskedWhereItHoldsDensity) {
-  DenseGrid half;
-  half.nx = half.ny = half.nz = 16;
-  half.data.assign(half.voxelCount(), 0.0f);
-  for (int z = 0; z < 16; ++z)
-    for (int y = 0; y < 16; ++y)
-      for (int x = 0; x < 8; ++x) half.data[size_t(x) + 16 * (size_t(y) + 16 * size_t(z))] = 1.0f;
-  half.maxValue = 1.0f;
+  const DenseGrid half = xSlabGrid(16, 0, 8);
   const Scene scene = sceneFromJson(boxScene(R"(, "density": 1)"));
   const DeviceScene ds = buildDeviceScene(scene, &half);
   const std::vector<uint32_t> mask = mediumMask(ds);

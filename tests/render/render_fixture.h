@@ -12,6 +12,7 @@
 #include "render/realtime_renderer.h"
 #include "shared/structs.h"
 #include "scene/scene.h"
+#include "volume/dense_grid.h"
 #include "unit/stat_util.h"
 
 namespace narval::test {
@@ -23,6 +24,18 @@ inline ClRuntime& runtime() {
 }
 
 inline Scene sceneFromJson(const std::string& json) { return parseScene(json, "test_scene.json"); }
+
+// An n³ grid of density 1 in the voxels x0 <= x < x1 (every y and z), 0 elsewhere.
+inline DenseGrid xSlabGrid(int n, int x0, int x1) {
+  DenseGrid g;
+  g.nx = g.ny = g.nz = n;
+  g.data.assign(g.voxelCount(), 0.0f);
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = x0; x < x1; ++x) g.data[size_t(x) + size_t(n) * (size_t(y) + size_t(n) * size_t(z))] = 1.0f;
+  g.maxValue = 1.0f;
+  return g;
+}
 
 // The path tracer. Every render helper takes the grid storage from the scene (renderer.storage;
 // auto: the buffer on PoCL), as the CLI does.
