@@ -2,8 +2,9 @@
 // over an empty background (`narval compare --medium-only`). A pixel is in the mask when the ray
 // through its centre from the lens's centre (the real-time kernels' ray, kernels/shared/camera.h)
 // crosses a cell that holds density of a majorant grid of its own, 64 cells on the grid's longest
-// axis (kernels/shared/majorant_dda.h): the medium's silhouette grown by at most a cell. It depends on the scene and the camera only, so
-// every algorithm writes the same mask for the same scene and compare judges them on the same pixels.
+// axis (kernels/shared/majorant_dda.h): the medium's silhouette grown by at most a cell. It depends
+// on the scene and the camera only, so every algorithm writes the same mask for the same scene and
+// compare judges them on the same pixels.
 #pragma once
 
 #include <cstdint>
@@ -16,8 +17,20 @@ namespace narval {
 // The EXR channel the renders write it to (UINT, 1 in the mask, 0 outside), beside R, G and B.
 constexpr const char* kMediumMaskChannel = "medium";
 
-// One value per pixel of ds.params.camera's image, row 0 at the top: 1 in the mask, else 0 (all 0
-// without a medium).
-std::vector<uint32_t> mediumMask(const DeviceScene& ds);
+// The mask of one scene's medium for any camera: its majorant grid is built once (a renderer keeps
+// one across snapshots and camera moves).
+class MediumMask {
+ public:
+  explicit MediumMask(const DeviceScene& ds);
+  // One value per pixel of `camera`'s image, row 0 at the top: 1 in the mask, else 0 (all 0 without
+  // a medium).
+  std::vector<uint32_t> pixels(const camera_params& camera) const;
+
+ private:
+  bool hasMedium_;
+  medium_params medium_;
+  majorant_grid_params cells_;
+  std::vector<float> bounds_;  // per cell, as MajorantGrid::maxDensity; one cell of 1: homogeneous
+};
 
 }  // namespace narval

@@ -8,7 +8,6 @@
 #include "cl/device_allocation.h"
 #include "render/device_scene.h"
 #include "render/majorant_options.h"
-#include "render/medium_mask.h"
 #include "render/render_common.h"
 
 namespace narval {
@@ -141,7 +140,7 @@ void PathtraceRenderer::readBack(RenderResult& into) {
   into.stats.nanPixels = 0;
   if (done_ > 0) {
     into.image = accumulatorImage(acc, W, H, &into.stats.nanPixels);
-    into.mediumMask = mediumMask(dev_.scene);
+    into.mediumMask = mediumMask().pixels(dev_.scene.params.camera);
   }
   if (options_.counters) {
     std::vector<cl_ulong> counts(pixels * 3);

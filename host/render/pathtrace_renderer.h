@@ -1,11 +1,13 @@
 // pathtrace_renderer.h: drives kernels/pathtrace.cl: upload, passes, exact accumulation.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cl/cl_runtime.h"
 #include "render/device_scene.h"
+#include "render/medium_mask.h"
 #include "render/render_types.h"
 #include "scene/scene.h"
 #include "volume/dense_grid.h"
@@ -47,6 +49,11 @@ class PathtraceRenderer {
   Scene view_;
   RenderOptions options_;
   DeviceSceneBuffers dev_;
+  std::optional<MediumMask> mask_;  // built at the first image (render/medium_mask.h)
+  const MediumMask& mediumMask() {
+    if (!mask_) mask_.emplace(dev_.scene);
+    return *mask_;
+  }
   cl::Program program_;
   NamedKernel kernel_;
   cl::Buffer accumBuf_, statusBuf_, counterBuf_;

@@ -10,7 +10,6 @@
 #include "render/device_scene.h"
 #include "render/lobe_directions.h"
 #include "render/majorant_options.h"
-#include "render/medium_mask.h"
 #include "render/node_grid_layout.h"
 #include "render/render_common.h"
 #include "volume/majorant_grid.h"
@@ -166,7 +165,7 @@ RenderResult RealtimeRenderer::result() {
   ms.budgetMin = msCache_.budgetMin();
   ms.budgetMax = msCache_.budgetMax();
   result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
-  result.mediumMask = mediumMask(dev_.scene);
+  result.mediumMask = mediumMask().pixels(dev_.scene.params.camera);
   return result;
 }
 

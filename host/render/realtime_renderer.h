@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "render/device_light_cache.h"
 #include "render/device_ms_cache.h"
 #include "render/device_scene.h"
+#include "render/medium_mask.h"
 #include "render/realtime_params.h"
 #include "render/render_types.h"
 #include "render/scene_upload.h"
@@ -55,6 +57,11 @@ class RealtimeRenderer {
   Scene view_;
   RenderOptions options_;
   DeviceSceneBuffers dev_;
+  std::optional<MediumMask> mask_;  // built at the first image (render/medium_mask.h)
+  const MediumMask& mediumMask() {
+    if (!mask_) mask_.emplace(dev_.scene);
+    return *mask_;
+  }
   double cachePixels_;  // the constructor's image size (realtimeParams)
   RealtimeParams params_;
   DeviceLightCache lightCache_;
