@@ -17,19 +17,17 @@ namespace narval {
 // The EXR channel the renders write it to (UINT, 1 in the mask, 0 outside), beside R, G and B.
 constexpr const char* kMediumMaskChannel = "medium";
 
-// The mask of one scene's medium for any camera: its majorant grid is built once (a renderer keeps
-// one across snapshots and camera moves).
+// The mask of one scene's medium for any of its cameras: the grid is bounded at the first call and
+// kept (a renderer keeps one across snapshots and camera moves).
 class MediumMask {
  public:
-  explicit MediumMask(const DeviceScene& ds);
-  // One value per pixel of `camera`'s image, row 0 at the top: 1 in the mask, else 0 (all 0 without
-  // a medium).
-  std::vector<uint32_t> pixels(const camera_params& camera) const;
+  // One value per pixel of ds.params.camera's image, row 0 at the top: 1 in the mask, else 0 (all 0
+  // without a medium). `ds` must be the same scene at every call, its camera free to change.
+  std::vector<uint32_t> pixels(const DeviceScene& ds);
 
  private:
-  bool hasMedium_;
-  medium_params medium_;
-  majorant_grid_params cells_;
+  bool built_ = false;
+  majorant_grid_params cells_{};
   std::vector<float> bounds_;  // per cell, as MajorantGrid::maxDensity; one cell of 1: homogeneous
 };
 

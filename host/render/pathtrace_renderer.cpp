@@ -138,10 +138,7 @@ void PathtraceRenderer::readBack(RenderResult& into) {
   into.stats.resumedFromSpp = first_;
   into.stats.interrupted = done_ < view_.renderer.spp;
   into.stats.nanPixels = 0;
-  if (done_ > 0) {
-    into.image = accumulatorImage(acc, W, H, &into.stats.nanPixels);
-    into.mediumMask = mediumMask().pixels(dev_.scene.params.camera);
-  }
+  if (done_ > 0) into.image = accumulatorImage(acc, W, H, &into.stats.nanPixels);
   if (options_.counters) {
     std::vector<cl_ulong> counts(pixels * 3);
     rt_.queue.enqueueReadBuffer(counterBuf_, CL_TRUE, 0, counts.size() * sizeof(cl_ulong), counts.data());
@@ -179,11 +176,13 @@ RenderResult renderPathtrace(ClRuntime& rt, const Scene& scene, SceneGrids grid,
       RenderResult partial;
       partial.stats = renderer.stats();
       renderer.readBack(partial);
+      partial.mediumMask = renderer.mediumMask();  // a partial EXR is a render's file like the last
       options.snapshot(partial);
     }
   }
   result.stats = renderer.stats();
   renderer.readBack(result);
+  result.mediumMask = renderer.mediumMask();
   RenderStats& st = result.stats;
   st.seconds = secondsSince(tLoop);
   st.frames = frameTimings(kernelMs, wallMs);

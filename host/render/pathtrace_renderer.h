@@ -1,7 +1,6 @@
 // pathtrace_renderer.h: drives kernels/pathtrace.cl: upload, passes, exact accumulation.
 #pragma once
 
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +40,9 @@ class PathtraceRenderer {
   RenderStats& stats() { return stats_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
   const DeviceScene& deviceScene() const { return dev_.scene; }
+  // The current camera's medium mask (render/medium_mask.h): what an EXR of the image holds beside
+  // it. Asked for by whoever writes one, not per frame: a host ray per pixel.
+  std::vector<uint32_t> mediumMask() { return mask_.pixels(dev_.scene); }
 
  private:
   void allocateAccumulator();
@@ -49,11 +51,7 @@ class PathtraceRenderer {
   Scene view_;
   RenderOptions options_;
   DeviceSceneBuffers dev_;
-  std::optional<MediumMask> mask_;  // built at the first image (render/medium_mask.h)
-  const MediumMask& mediumMask() {
-    if (!mask_) mask_.emplace(dev_.scene);
-    return *mask_;
-  }
+  MediumMask mask_;
   cl::Program program_;
   NamedKernel kernel_;
   cl::Buffer accumBuf_, statusBuf_, counterBuf_;

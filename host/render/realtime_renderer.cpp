@@ -165,7 +165,6 @@ RenderResult RealtimeRenderer::result() {
   ms.budgetMin = msCache_.budgetMin();
   ms.budgetMax = msCache_.budgetMax();
   result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
-  result.mediumMask = mediumMask().pixels(dev_.scene.params.camera);
   return result;
 }
 
@@ -195,6 +194,7 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, SceneGrids grid, 
     return result;
   }
   RenderResult result = renderer.result();
+  result.mediumMask = renderer.mediumMask();
   RenderStats& st = result.stats;
   st.buildSeconds = buildSeconds;
   st.interrupted = int(kernelMs.size()) < requested;

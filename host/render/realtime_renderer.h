@@ -7,7 +7,6 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +48,9 @@ class RealtimeRenderer {
   const RenderStats& stats() const { return stats_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
   const DeviceScene& deviceScene() const { return dev_.scene; }
+  // The current camera's medium mask (render/medium_mask.h): what an EXR of the image holds beside
+  // it. Asked for by whoever writes one, not per frame: a host ray per pixel.
+  std::vector<uint32_t> mediumMask() { return mask_.pixels(dev_.scene); }
 
  private:
   // The scene, once its algorithm and the options are known to suit a real-time renderer.
@@ -57,11 +59,7 @@ class RealtimeRenderer {
   Scene view_;
   RenderOptions options_;
   DeviceSceneBuffers dev_;
-  std::optional<MediumMask> mask_;  // built at the first image (render/medium_mask.h)
-  const MediumMask& mediumMask() {
-    if (!mask_) mask_.emplace(dev_.scene);
-    return *mask_;
-  }
+  MediumMask mask_;
   double cachePixels_;  // the constructor's image size (realtimeParams)
   RealtimeParams params_;
   DeviceLightCache lightCache_;

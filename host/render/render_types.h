@@ -46,7 +46,7 @@ struct RenderResult {
   AccumulatorState accumulator; // pathtrace only
   RenderStats stats;
   std::vector<std::string> warnings;  // from preparing the scene for the device
-  std::vector<uint32_t> mediumMask;   // per pixel, render/medium_mask.h; empty when interrupted before the first pass
+  std::vector<uint32_t> mediumMask;   // per pixel, render/medium_mask.h: set where an EXR is written, else empty
 };
 
 }  // namespace narval

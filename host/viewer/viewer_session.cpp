@@ -209,12 +209,14 @@ void ViewerSession::renderFrame() {
     if (count > 0 || r.samples() == 0) ms = r.addSamples(std::max(1, count));
     result.stats = r.stats();
     r.readBack(result);
+    if (snapshot_) result.mediumMask = r.mediumMask();
     spp_ = r.samples();
   } else {
     RealtimeRenderer& r = realtime(view);
     // A snapshot must be what `narval render` of its scene draws: the cache complete first.
     ms = r.renderFrame(/*progressiveCache=*/!snapshot_);
     result = r.result();
+    if (snapshot_) result.mediumMask = r.mediumMask();
     spp_ = 1;
   }
   if (ms > 0)

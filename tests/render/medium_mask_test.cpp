@@ -52,7 +52,7 @@ bool slab(const Ray& r, const double lo[3], const double hi[3], double* t0, doub
 TEST(MediumMask, AHomogeneousBoxIsThePixelsWhoseRayCrossesIt) {
   const Scene scene = sceneFromJson(boxScene(""));
   const DeviceScene ds = buildDeviceScene(scene, {});
-  const std::vector<uint32_t> mask = MediumMask(ds).pixels(ds.params.camera);
+  const std::vector<uint32_t> mask = MediumMask().pixels(ds);
   const camera_params& cam = ds.params.camera;
   ASSERT_EQ(mask.size(), size_t(36 * 24));
   const double lo[3] = {1 - 8, 0.5 - 8, -8}, hi[3] = {1 + 8, 0.5 + 8, 8};
@@ -86,7 +86,7 @@ TEST(MediumMask, AGridIsMaskedWhereItHoldsDensity) {
   const DenseGrid half = xSlabGrid(16, 0, 8);
   const Scene scene = sceneFromJson(boxScene(R"(, "density": 1)"));
   const DeviceScene ds = buildDeviceScene(scene, &half);
-  const std::vector<uint32_t> mask = MediumMask(ds).pixels(ds.params.camera);
+  const std::vector<uint32_t> mask = MediumMask().pixels(ds);
   const camera_params& cam = ds.params.camera;
   const nv_affine& toIndex = ds.params.medium.world_to_index;
   const double lo[3] = {1 - 8, 0.5 - 8, -8}, hi[3] = {1 + 8, 0.5 + 8, 8};
