@@ -1,14 +1,16 @@
 /* ms_cache.cl: adds `count` paths per node to the multiple-scattering cache (shared/ms_cache_build.h),
- * paths [first, first + count) of each node, after the view layout's nodes were placed (once per
- * cache). One work-item per node (1D, padded to a multiple of the local size). `scene` is the scene
- * with one bounce fewer (ms_cache.h, "Bounces"). */
+ * paths [first, first + count) of nodes [node_first, node_first + node_count), after the view layout's
+ * nodes were placed (once per cache). One work-item per node of the range (1D, padded to a multiple of
+ * the local size): a budgeted refinement adds a sweep's paths a slice of nodes at a time
+ * (host/render/device_ms_cache.cpp). `scene` is the scene with one bounce fewer (ms_cache.h, "Bounces"). */
 #include "shared/scene_kinds.h"
 #include "shared/ms_cache_build.h"
 #include "shared/ms_cache_filter.h"
 
-__kernel void ms_cache_build(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, uint first, uint count,
-                             __global float* cache, __global uint* status_word) {
-  const int node = get_global_id(0);
+__kernel void ms_cache_build(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, uint node_first, uint node_count,
+                             uint first, uint count, __global float* cache, __global uint* status_word) {
+  if (get_global_id(0) >= node_count) return;
+  const int node = (int)(node_first + get_global_id(0));
   if (node >= node_grid_count(&ms_cache.grid)) return;
   KERNEL_CONTEXT_BEGIN(ctx);
   ctx.status = scene_kinds_status(scene, lights) | ms_cache_kinds_status(&ms_cache); /* STATUS_UNKNOWN_KIND */
@@ -16,11 +18,13 @@ __kernel void ms_cache_build(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, uint f
   if (ctx.status) atomic_or(status_word, ctx.status);
 }
 
-/* The view layout's placement (ms_cache_view.h, ms_view_place_column): one work-item per column,
- * run once when the cache starts over, before ms_cache_build. */
-__kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, __global float* cache,
-                                  __global uint* status_word) {
-  const int column = get_global_id(0);
+/* The view layout's placement (ms_cache_view.h, ms_view_place_column): one work-item per column of
+ * [column_first, column_first + column_count), every column once when the cache starts over, before
+ * ms_cache_build. */
+__kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, uint column_first, uint column_count,
+                                  __global float* cache, __global uint* status_word) {
+  if (get_global_id(0) >= column_count) return;
+  const int column = (int)(column_first + get_global_id(0));
   if (column >= ms_cache.grid.nx * ms_cache.grid.ny) return;
   KERNEL_CONTEXT_BEGIN(ctx);
   ctx.status = scene_kinds_status(scene, lights) | ms_cache_kinds_status(&ms_cache); /* STATUS_UNKNOWN_KIND */
@@ -28,13 +32,16 @@ __kernel void ms_cache_place_view(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, _
   if (ctx.status) atomic_or(status_word, ctx.status);
 }
 
-/* The view layout's filter (ms_cache_filter.h): one work-item per column, after every
- * ms_cache_build launch; `filtered` (the cache's layout, a copy of each node with its R filtered)
- * is what the march reads. The weights from `cache`, the values from `values`: the cache itself,
- * or with `residual` 1 the first pass's output, for twicing's second pass. */
-__kernel void ms_cache_filter_view(ms_cache_params ms_cache, __global const float* cache,
-                                   __global const float* values, int residual, __global float* filtered) {
-  const int column = get_global_id(0);
+/* The view layout's filter (ms_cache_filter.h): one work-item per column of
+ * [column_first, column_first + column_count), after the paths changed; `filtered` (the cache's layout,
+ * a copy of each node with its R filtered) is what the march reads once every column is done. The
+ * weights from `cache`, the values from `values`: the cache itself, or with `residual` 1 the first
+ * pass's output, for twicing's second pass. */
+__kernel void ms_cache_filter_view(ms_cache_params ms_cache, uint column_first, uint column_count,
+                                   __global const float* cache, __global const float* values, int residual,
+                                   __global float* filtered) {
+  if (get_global_id(0) >= column_count) return;
+  const int column = (int)(column_first + get_global_id(0));
   if (column >= ms_cache.grid.nx * ms_cache.grid.ny) return;
   ms_view_filter_column(&ms_cache.grid, cache, values, residual, column, ms_cache.filter, ms_cache.filter_tolerance,
                         filtered + (size_t)column * MS_CACHE_STRIDE);

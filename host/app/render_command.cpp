@@ -34,7 +34,7 @@ struct RenderArgs {
   std::optional<double> exposure;
   std::string tonemap;
   std::string majorant = "auto", storage, displayServer;
-  double partialEverySeconds = 0;
+  double partialEverySeconds = 0, targetMs = 0;
   long long seed = -1;
   std::vector<std::string> sets;
 };
@@ -81,6 +81,9 @@ void resumeMajorant(const std::string& out, const RenderArgs& a, std::string* ma
 // The real-time algorithms take one estimate per pixel per frame; only the ray marcher's
 // multiple-scattering cache traces paths, and it takes the scene's bounces.
 void refuseFlagsThatDoNotApply(const RenderArgs& a, const Scene& scene) {
+  if (a.targetMs > 0 && !isRealtime(scene.renderer.algorithm))
+    throw inputError("--target-ms", "", "only the real-time algorithms render frames in a budget; the algorithm is " +
+                                            std::string(algorithmName(scene.renderer.algorithm)));
   if (!isRealtime(scene.renderer.algorithm)) return;
   const std::string algorithm = algorithmName(scene.renderer.algorithm);
   const std::string frames = "does not apply to " + algorithm + ", which renders frames (use --frames)";
@@ -278,6 +281,7 @@ int runRender(const RenderArgs& a) {
   options.majorant = resume.majorant;
   options.majorantResolution = resume.majorantResolution;
   options.counters = a.counters;
+  options.frameBudgetMs = a.targetMs;
   snapshots.install(options);
   const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)
                                   : renderPathtrace(rt, scene, g, options);
@@ -316,6 +320,10 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("--frames", a->frames,
                   "Render K frames and report ms per frame (pathtrace: K passes of 1 spp)")
       ->check(atLeast(1));
+  sub->add_option("--target-ms", a->targetMs,
+                  "Real-time, with --frames: a frame's budget, as the viewer's; the multiple-scattering cache is "
+                  "built over the frames in what each leaves of it (the image is the last frame's)")
+      ->check(greaterThanZero());
   sub->add_option("--stats-json", a->statsJson, "Write render statistics as JSON");
   sub->add_option("--storage", a->storage,
                   "Density grid on the device: image (3D image, hardware sampler), buffer (float buffer, the "
@@ -351,6 +359,7 @@ Command addRenderCommand(CLI::App& app) {
   addThreadsOption(sub);
   CLI::Option* frames = sub->get_option("--frames");
   sub->get_option("--samples")->excludes(frames);
+  sub->get_option("--target-ms")->needs(frames);
   sub->add_flag("--resume", a->resume,
                 "pathtrace: continue the render already at the output path (interrupted, or with fewer spp) "
                 "to the requested spp; the pixels equal those of one uninterrupted render")

@@ -132,8 +132,9 @@ Command addViewCommand(CLI::App& app) {
   sub->add_option("--set", a->sets, "Override a scene value: dotted.path=value (repeatable)");
   sub->add_option("--resolution", a->resolution, "WIDTHxHEIGHT of the full-size frames");
   sub->add_option("--target-ms", a->targetMs,
-                  "While the camera moves, render at 1/2, 1/4 or 1/8 resolution so that a frame takes about this "
-                  "long (default 50)")
+                  "A frame's budget: while the camera moves, render at 1/2, 1/4 or 1/8 resolution so that a frame "
+                  "takes about this long, and build the multiple-scattering cache in the time a frame leaves "
+                  "(default 50)")
       ->check(greaterThanZero());
   sub->add_option("--script", a->script,
                   "Replay the inputs in FILE instead of a user (key, drag, scroll, hold, frames; docs/viewer.md)");

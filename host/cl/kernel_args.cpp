@@ -29,9 +29,9 @@ const std::map<std::string, std::vector<std::string>>& lists() {
       {"lobe", sceneArgsAnd({"march", "lobe", "light_cache", "lobe_directions", "light_cache_nodes", "out",
                              "status_word"})},
       {"light_cache_build", sceneArgsAnd({"march", "light_cache", "light", "cache", "status_word"})},
-      {"ms_cache_build", sceneArgsAnd({"ms_cache", "first", "count", "cache", "status_word"})},
-      {"ms_cache_place_view", sceneArgsAnd({"ms_cache", "cache", "status_word"})},
-      {"ms_cache_filter_view", {"ms_cache", "cache", "values", "residual", "filtered"}},
+      {"ms_cache_build", sceneArgsAnd({"ms_cache", "node_first", "node_count", "first", "count", "cache", "status_word"})},
+      {"ms_cache_place_view", sceneArgsAnd({"ms_cache", "column_first", "column_count", "cache", "status_word"})},
+      {"ms_cache_filter_view", {"ms_cache", "column_first", "column_count", "cache", "values", "residual", "filtered"}},
   };
   return all;
 }

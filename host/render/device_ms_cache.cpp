@@ -15,7 +15,7 @@ namespace narval {
 
 void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params,
                            int targetPaths, int pathsPerLaunch, const std::string& sceneFile,
-                           const MsCacheAllocation& allocation) {
+                           const MsCacheAllocation& allocation, double budgetMs) {
   const node_grid_params& c = params.grid;
   if (c.nx <= 0) throw std::invalid_argument("DeviceMsCache::refine: the cache is off (nx = 0)");
   const size_t nodes = nodeGridCount(c);
@@ -45,11 +45,18 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
                                   "x" + std::to_string(c.nz) + " nodes"};
     buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
-    filtered_ = twiced_ = cl::Buffer();  // allocated by the filter when it is on
+    front_ = back_ = mid_ = cl::Buffer();  // allocated by the filter when it is on
     filteredKey_.clear();
+    filteredPaths_ = -1;
+    frontReady_ = false;
+    filterPass_ = 0;
+    activePrefix_.clear();
     rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
-    program_ = buildProgram(rt, "ms_cache.cl", dev.buildOptions());
-    kernel_ = NamedKernel(program_, "ms_cache_build");
+    if (dev.buildOptions() != programOptions_) {  // kept across start-overs (a view cache's camera moves)
+      programOptions_ = dev.buildOptions();
+      program_ = buildProgram(rt, "ms_cache.cl", programOptions_);
+      kernel_ = NamedKernel(program_, "ms_cache_build");
+    }
     walkMajorants(rt, dev, pathScene);
     sceneBuf_ = constantBuffer(rt, pathScene);
     const medium_params& m = pathScene.medium;
@@ -58,22 +65,17 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     albedo_ = st > 0 ? ss / st : 0.0;
     statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
     rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
-    paths_ = budgetMin_ = budgetMax_ = 0;
+    paths_ = budgetMin_ = budgetMax_ = sweepPaths_ = 0;
+    sweepNode_ = 0;
     allocation_ = allocation;
     ++rebuilds_;
     key_ = key;
-    if (view) {  // the nodes' places along their columns, once (ms_cache_view.h, "Layout")
-      NamedKernel place(program_, "ms_cache_place_view");
-      dev.bind(place);
-      place.set("scene", sceneBuf_);
-      place.set("grid_majorants", majorantBuf_);
-      place.set("ms_cache", params);
-      place.set("cache", buffer_);
-      place.set("status_word", statusBuf_);
-      buildMs_ += launchOverNodes(rt, place.get(), size_t(c.nx) * size_t(c.ny), "the multiple-scattering cache",
-                                  deviceSceneBytes(dev.scene) + bytes_);
-    }
+    placed_ = view ? 0 : size_t(-1);  // the view nodes' places, first (place())
   }
+  budgeted_ = budgetMs > 0;
+  budgetLeftMs_ = budgetMs;
+  if (filterOn_ && filterPass_ > 0) filter(rt, params);  // a filtered copy under way first
+  if (!place(rt, dev, params)) return;                   // budget spent before every column is placed
   int launches = targetPaths;
   if (allocation_.perceptual) {  // the pilot first, then the budgets from it, then the launches they need
     const int pilot = msAllocationPilot(allocation_.meanPaths);
@@ -83,6 +85,11 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   }
   if (paths_ < launches) addPaths(rt, dev, params, launches, pathsPerLaunch);
   if (filterOn_) filter(rt, params);
+}
+
+double DeviceMsCache::pathsDone() const {
+  const size_t nodes = bytes_ / (MS_CACHE_STRIDE * sizeof(float));
+  return paths() + (nodes > 0 ? double(sweepPaths_) * double(sweepNode_) / double(nodes) : 0.0);
 }
 
 int DeviceMsCache::paths() const {
@@ -142,6 +149,77 @@ void DeviceMsCache::walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, 
   majorantBuf_ = walkedOwn_ ? walkedBuf_ : dev.majorantBuf;
 }
 
+// The view layout's nodes' places along their columns, once per cache (ms_cache_view.h, "Layout"), in
+// budgeted column slices; true once every column is placed (the grid layout's nodes always are).
+bool DeviceMsCache::place(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params) {
+  const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);
+  if (placed_ >= columns) return true;
+  NamedKernel place(program_, "ms_cache_place_view");
+  dev.bind(place);
+  place.set("scene", sceneBuf_);
+  place.set("grid_majorants", majorantBuf_);
+  place.set("ms_cache", params);
+  place.set("cache", buffer_);
+  place.set("status_word", statusBuf_);
+  while (placed_ < columns) {
+    if (budgeted_ && budgetLeftMs_ <= 0) return false;
+    const size_t end = budgeted_ ? std::min(columns, placed_ + std::max<size_t>(64, size_t(unitsThatFit(msPerPlace_, 1024, lastPlaced_))))
+                                 : columns;
+    place.set("column_first", cl_uint(placed_));
+    place.set("column_count", cl_uint(end - placed_));
+    const double ms = launchOverNodes(rt, place.get(), end - placed_, "the multiple-scattering cache",
+                                      deviceSceneBytes(dev.scene) + bytes_);
+    buildMs_ += ms;
+    if (budgeted_) {
+      lastPlaced_ = end - placed_;
+      msPerPlace_ = std::max(1e-9, ms / double(lastPlaced_));
+      budgetLeftMs_ -= ms;
+    }
+    placed_ = end;
+  }
+  return true;
+}
+
+// Active units before node n: nodes of columns that hold medium in the view layout (the others take
+// no paths), every node in the grid layout; for n below the column count, columns with medium.
+size_t DeviceMsCache::activeBefore(size_t n) const {
+  if (activePrefix_.empty()) return n;
+  const size_t columns = activePrefix_.size() - 1;
+  return (n / columns) * activePrefix_.back() + activePrefix_[n % columns];
+}
+
+// The end of a budgeted slice from `first` (at most `end`): the nodes or columns holding `units` active
+// ones, at least one (a slice across empty space takes it all up to the next active unit).
+size_t DeviceMsCache::sliceEnd(size_t first, size_t end, double units) const {
+  const size_t want = activeBefore(first) + size_t(std::max(1.0, std::min(units, 1e15)));
+  size_t lo = first + 1, hi = end;  // the least n in [lo, hi] with activeBefore(n) >= want, else end
+  while (lo < hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (activeBefore(mid) >= want) hi = mid; else lo = mid + 1;
+  }
+  return lo;
+}
+
+// In the view layout, which columns hold medium (a node's cost is its column's): read once per cache,
+// from slice 0's placement, when a budget first needs it.
+void DeviceMsCache::countActive(ClRuntime& rt, const ms_cache_params& params) {
+  if (!activePrefix_.empty() || params.layout != MS_CACHE_LAYOUT_VIEW) return;
+  const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);
+  std::vector<float> slice0(columns * MS_CACHE_STRIDE);
+  rt.queue.enqueueReadBuffer(buffer_, CL_TRUE, 0, slice0.size() * sizeof(float), slice0.data());
+  activePrefix_.assign(columns + 1, 0);
+  for (size_t c = 0; c < columns; ++c)
+    activePrefix_[c + 1] = activePrefix_[c] + (slice0[c * MS_CACHE_STRIDE + MS_VIEW_TAU] >= 0.0f ? 1 : 0);
+}
+
+// The units a budgeted slice of cost `msPerUnit` each can take with the budget left (`pilot` before
+// anything was measured), growing at most fourfold from the last (costs vary across the medium).
+double DeviceMsCache::unitsThatFit(double msPerUnit, double pilot, size_t lastUnits) const {
+  double units = msPerUnit > 0 ? budgetLeftMs_ / msPerUnit : pilot;
+  if (lastUnits > 0) units = std::min(units, 4.0 * double(lastUnits));
+  return units;
+}
+
 void DeviceMsCache::addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params,
                              int targetPaths, int pathsPerLaunch) {
   const size_t nodes = nodeGridCount(params.grid);
@@ -151,40 +229,93 @@ void DeviceMsCache::addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const
   kernel_.set("ms_cache", params);
   kernel_.set("cache", buffer_);
   kernel_.set("status_word", statusBuf_);
+  if (budgeted_) countActive(rt, params);
   while (paths_ < targetPaths) {
-    const int count = std::min(std::max(1, pathsPerLaunch), targetPaths - paths_);
+    if (sweepPaths_ == 0)  // a new sweep: budgeted, as many paths as the nodes hold (the noise halves)
+      sweepPaths_ = std::min({std::max(1, pathsPerLaunch), targetPaths - paths_, budgeted_ ? std::max(1, paths_) : 1 << 30});
+    size_t end = nodes;
+    if (budgeted_) {
+      if (budgetLeftMs_ <= 0) break;  // spent: the next slice waits for the next call
+      end = sliceEnd(sweepNode_, nodes, unitsThatFit(msPerNodePath_ * sweepPaths_, 512, lastNodes_));
+    }
+    kernel_.set("node_first", cl_uint(sweepNode_));
+    kernel_.set("node_count", cl_uint(end - sweepNode_));
     kernel_.set("first", cl_uint(paths_));
-    kernel_.set("count", cl_uint(count));
-    buildMs_ += launchOverNodes(rt, kernel_.get(), nodes, "the multiple-scattering cache",
-                                deviceSceneBytes(dev.scene) + bytes_);
-    paths_ += count;
+    kernel_.set("count", cl_uint(sweepPaths_));
+    const double ms = launchOverNodes(rt, kernel_.get(), end - sweepNode_, "the multiple-scattering cache",
+                                      deviceSceneBytes(dev.scene) + bytes_);
+    ++launches_;
+    buildMs_ += ms;
+    if (budgeted_) {
+      lastNodes_ = std::max<size_t>(1, activeBefore(end) - activeBefore(sweepNode_));
+      msPerNodePath_ = std::max(1e-9, ms / (double(lastNodes_) * sweepPaths_));
+      budgetLeftMs_ -= ms;
+    }
+    sweepNode_ = end;
+    if (sweepNode_ == nodes) {
+      paths_ += sweepPaths_;
+      sweepNode_ = 0;
+      sweepPaths_ = 0;
+    }
   }
   status_ |= readStatusWord(rt, statusBuf_);
 }
 
+// The filtered copy of the paths so far, made into back_ (twicing: its first pass into mid_) column
+// slice by column slice, then swapped to the front that the march reads: a budgeted refine never
+// shows a half-filtered copy, and until the first is done the march reads the running means.
 void DeviceMsCache::filter(ClRuntime& rt, const ms_cache_params& params) {
-  if (!filtered_()) filtered_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
-  if (twicingOn_ && !twiced_()) twiced_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
   const std::string key = std::to_string(paths_) + "/" + rawBytes(params.filter) +
                           rawBytes(params.filter_tolerance) + (twicingOn_ ? "/twiced" : "");
-  if (key == filteredKey_) return;
+  if (filterPass_ == 0) {
+    if (key == filteredKey_ || paths_ == 0) return;  // nothing to filter before the first sweep
+    filterPass_ = 1;
+    filterColumn_ = 0;
+    filteringKey_ = key;
+    filteringPaths_ = paths_;
+  }
+  for (cl::Buffer* b : {&front_, &back_, &mid_})
+    if (!(*b)() && (b != &mid_ || twicingOn_)) *b = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+  if (budgeted_) countActive(rt, params);
   NamedKernel filter(program_, "ms_cache_filter_view");
   filter.set("ms_cache", params);
   filter.set("cache", buffer_);
   const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);
-  // S(J), then with twicing 2·S(J) − S(S(J)) from it, the weights both times the running means'
-  // (ms_cache_filter.h, "Twicing").
-  filter.set("values", buffer_);
-  filter.set("residual", cl_int(0));
-  filter.set("filtered", filtered_);
-  buildMs_ += launchOverNodes(rt, filter.get(), columns, "the multiple-scattering cache", 2 * bytes_);
-  if (twicingOn_) {
-    filter.set("values", filtered_);
-    filter.set("residual", cl_int(1));
-    filter.set("filtered", twiced_);
-    buildMs_ += launchOverNodes(rt, filter.get(), columns, "the multiple-scattering cache", 3 * bytes_);
+  while (filterPass_ > 0) {
+    // S(J), then with twicing 2·S(J) − S(S(J)) from it, the weights both times the running means'
+    // (ms_cache_filter.h, "Twicing").
+    const bool second = filterPass_ == 2;
+    size_t end = columns;
+    if (budgeted_) {
+      if (budgetLeftMs_ <= 0) return;
+      end = sliceEnd(filterColumn_, columns, unitsThatFit(msPerColumn_, 512, lastColumns_));
+    }
+    filter.set("column_first", cl_uint(filterColumn_));
+    filter.set("column_count", cl_uint(end - filterColumn_));
+    filter.set("values", second ? mid_ : buffer_);
+    filter.set("residual", cl_int(second ? 1 : 0));
+    filter.set("filtered", twicingOn_ && !second ? mid_ : back_);
+    const double ms = launchOverNodes(rt, filter.get(), end - filterColumn_, "the multiple-scattering cache",
+                                      (second ? 3 : 2) * bytes_);
+    buildMs_ += ms;
+    if (budgeted_) {
+      lastColumns_ = std::max<size_t>(1, activeBefore(end) - activeBefore(filterColumn_));
+      msPerColumn_ = std::max(1e-9, ms / double(lastColumns_));
+      budgetLeftMs_ -= ms;
+    }
+    filterColumn_ = end;
+    if (filterColumn_ < columns) continue;
+    filterColumn_ = 0;
+    if (twicingOn_ && !second) {
+      filterPass_ = 2;
+      continue;
+    }
+    std::swap(front_, back_);
+    frontReady_ = true;
+    filterPass_ = 0;
+    filteredKey_ = filteringKey_;
+    filteredPaths_ = filteringPaths_;
   }
-  filteredKey_ = key;
 }
 
 }  // namespace narval

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "cl/cl_runtime.h"
 #include "cl/device_allocation.h"
@@ -21,13 +22,25 @@ class DeviceMsCache {
   // `sceneFile` and renderer.raymarch.msCache.resolution) when over the device's largest allocation. With
   // allocation.perceptual (view layout; ms_cache_allocation.h) nodes take the pilot, then columns their budgets
   // (averaging allocation.meanPaths, towards which `targetPaths` counts; paths() reaches it once all are spent).
+  // With budgetMs > 0 it stops once about that much build time (by profiling events) is spent, in slices
+  // of nodes sized by the last slice's cost per node and path (at least one slice a call, so every call
+  // progresses): a viewer's frame never waits for a whole launch. Budgeted sweeps add as many paths as
+  // the nodes hold (1, 1, 2, 4, ... up to pathsPerLaunch), so the noise halves sweep by sweep. A node's
+  // paths are the same whatever the slices and sweeps, so the cache after K paths is too, bit for bit.
   void refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params, int targetPaths,
-              int pathsPerLaunch, const std::string& sceneFile, const MsCacheAllocation& allocation = {});
+              int pathsPerLaunch, const std::string& sceneFile, const MsCacheAllocation& allocation = {},
+              double budgetMs = 0);
   // What the march reads: the running means or, with the view layout's filter (params.filter > 0;
   // kernels/shared/ms_cache_filter.h), their filtered copy, twiced when params.filter_twicing is set.
-  const cl::Buffer& buffer() const { return twicingOn_ ? twiced_ : filterOn_ ? filtered_ : buffer_; }
+  // A budgeted refine makes the filtered copy over several calls; until the first is done, the means.
+  const cl::Buffer& buffer() const { return filterOn_ && frontReady_ ? front_ : buffer_; }
   const cl::Buffer& means() const { return buffer_; }  // the running means, unfiltered
   int paths() const;                               // paths per node so far (allocated: their mean, pro rata)
+  // paths() plus the share of the sweep under way (a budgeted refine may stop between its slices).
+  double pathsDone() const;
+  int launches() const { return launches_; }       // build launches so far, slices included
+  // A budgeted refine has yet to make the filtered copy of the paths so far (the view layout's filter).
+  bool filterPending() const { return filterOn_ && (filterPass_ > 0 || filteredPaths_ != paths_); }
   // The perceptual allocation's smallest and largest budget (0, 0 before it is set or when off).
   int budgetMin() const { return budgetMin_; }
   int budgetMax() const { return budgetMax_; }
@@ -39,8 +52,14 @@ class DeviceMsCache {
  private:
   void addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params, int targetPaths,
                 int pathsPerLaunch);
-  // The filtered copy, when the paths or settings changed.
+  // The filtered copy, when the paths or settings changed (budgeted: continued over calls).
   void filter(ClRuntime& rt, const ms_cache_params& params);
+  bool place(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params);
+  // Budgeted slices (device_ms_cache.cpp).
+  size_t activeBefore(size_t n) const;
+  size_t sliceEnd(size_t first, size_t end, double units) const;
+  void countActive(ClRuntime& rt, const ms_cache_params& params);
+  double unitsThatFit(double msPerUnit, double pilot, size_t lastUnits) const;
   // The perceptual allocation (ms_cache.cpp): budgets after the pilot, and the launch index `targetPaths` maps to.
   void setBudgets(ClRuntime& rt, const ms_cache_params& params);
   int allocatedLaunches(int targetPaths) const;
@@ -50,8 +69,18 @@ class DeviceMsCache {
   std::string key_;
   AllocationSite site_;  // what an allocation failure names (the scene file and key)
   cl::Program program_;
+  std::string programOptions_;
+  size_t placed_ = 0;  // view layout: columns placed so far
   NamedKernel kernel_;
-  cl::Buffer buffer_, filtered_, twiced_, sceneBuf_, majorantBuf_, statusBuf_;
+  cl::Buffer buffer_, sceneBuf_, majorantBuf_, statusBuf_;
+  // The filtered copy: front_ is what the march reads once frontReady_; back_ the one being made, mid_
+  // twicing's first pass. filterPass_: 0 none under way, 1 the first pass, 2 twicing's second.
+  cl::Buffer front_, back_, mid_;
+  bool frontReady_ = false;
+  int filterPass_ = 0;
+  size_t filterColumn_ = 0;
+  std::string filteringKey_;
+  int filteringPaths_ = -1, filteredPaths_ = -1;
   std::string walkedKey_;                // the grid and resolution walkedBuf_ was built for
   bool walkedOwn_ = false;               // the paths walk walkedGrid_ (else the march's grid)
   majorant_grid_params walkedGrid_{};
@@ -59,6 +88,17 @@ class DeviceMsCache {
   bool filterOn_ = false, twicingOn_ = false;
   std::string filteredKey_;  // the paths and filter settings the filtered copy was made from
   int paths_ = 0, rebuilds_ = 0;  // paths_: the launches' path index (every node's count, unless budgeted)
+  // The sweep under way: nodes [0, sweepNode_) hold paths_ + sweepPaths_ paths, the rest paths_.
+  size_t sweepNode_ = 0;
+  int sweepPaths_ = 0;  // 0: no sweep under way
+  int launches_ = 0;
+  bool budgeted_ = false;     // the refine under way has a budget
+  double budgetLeftMs_ = 0;   // its build time left
+  // The last slice's cost per active node and path (per active column: the filter's), which sizes the
+  // next, kept across start-overs; its active units; the view layout's active columns, prefix-summed.
+  double msPerNodePath_ = 0, msPerColumn_ = 0, msPerPlace_ = 0;
+  size_t lastNodes_ = 0, lastColumns_ = 0, lastPlaced_ = 0;
+  std::vector<size_t> activePrefix_;
   MsCacheAllocation allocation_;
   double albedo_ = 0;  // the medium's grey albedo σs/σt (channel sums), which the allocation's Y takes
   int budgetMin_ = 0, budgetMax_ = 0;  // set: the budgets are in the nodes

@@ -103,21 +103,21 @@ void RealtimeRenderer::setView(const Scene& view) {
   stats_.height = H;
 }
 
-double RealtimeRenderer::renderFrame(bool progressiveCache, double* wallMs) {
+double RealtimeRenderer::renderFrame(double cacheBudgetMs, double* wallMs) {
   if (params_.lightCache.nx > 0) {  // a no-op unless the medium or a light changed
     lightCache_.update(rt_, dev_, params_.march, params_.lightCache, view_.sourcePath);
     kernel_.set("light_cache_nodes", lightCache_.buffer());
   }
-  if (params_.msCache.grid.nx > 0) {  // built to its paths (progressively: one launch a frame), then kept
+  if (params_.msCache.grid.nx > 0) {  // built to its paths (within a budget: over frames), then kept
     const MsCacheSettings& mc = view_.renderer.raymarch.msCache;
-    const int target = progressiveCache ? std::min(mc.paths, msCache_.paths() + mc.pathsPerLaunch) : mc.paths;
     MsCacheAllocation allocation;
     allocation.perceptual =
         mc.layout == MsCacheLayout::View && mc.allocation == MsCacheAllocationKind::Perceptual;
     allocation.meanPaths = mc.paths;
     allocation.toneMapping = view_.renderer.toneMapping;
     allocation.exposure = view_.renderer.exposure;
-    msCache_.refine(rt_, dev_, params_.msCache, target, mc.pathsPerLaunch, view_.sourcePath, allocation);
+    msCache_.refine(rt_, dev_, params_.msCache, mc.paths, mc.pathsPerLaunch, view_.sourcePath, allocation,
+                    cacheBudgetMs);
     kernel_.set("ms_cache_nodes", msCache_.buffer());
   }
   const int W = view_.renderer.width, H = view_.renderer.height;
@@ -149,6 +149,7 @@ RenderResult RealtimeRenderer::result() {
   const ms_cache_params& mc = params_.msCache;
   ms.ms = msCache_.buildMs();
   ms.paths = msCache_.paths();
+  ms.progress = mc.grid.nx > 0 ? std::min(1.0, msCache_.pathsDone() / std::max(1, view_.renderer.raymarch.msCache.paths)) : 0;
   ms.builds = msCache_.rebuilds();
   ms.view = mc.layout == MS_CACHE_LAYOUT_VIEW;
   if (ms.view) {  // its nodes are not cell corners: columns, rows, slices
@@ -178,9 +179,12 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, SceneGrids grid, 
   // One launch per frame, each timed by its profiling event and by the wall clock around it.
   const int requested = std::max(1, frames);
   std::vector<double> kernelMs, wallMs;
+  const double budget = options.frameBudgetMs;
   for (int f = 0; f < requested && !cancelled(options); ++f) {
     double wall = 0;
-    kernelMs.push_back(renderer.renderFrame(false, &wall));
+    const auto frameStart = std::chrono::steady_clock::now();
+    kernelMs.push_back(renderer.renderFrame(cacheBudgetMs(budget, kernelMs.empty() ? 0 : kernelMs.back()), &wall));
+    if (budget > 0) wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frameStart).count();
     wallMs.push_back(wall);
     if (options.progress) options.progress(f + 1, requested);
   }

@@ -6,6 +6,7 @@
 // (counted in RenderStats).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -38,11 +39,11 @@ class RealtimeRenderer {
   // automatic light cache is weighed against the constructor's resolution, so that frames drawn
   // smaller (a viewer in motion) keep it.
   void setView(const Scene& view);
-  // One frame: brings the caches up to date (progressiveCache: at most one launch of the
-  // multiple-scattering cache, so a viewer refines it over frames; otherwise all of it), then one
-  // launch of the kernel, waited for. Returns its milliseconds by profiling event; wallMs, when not
-  // null, gets the wall clock around the launch.
-  double renderFrame(bool progressiveCache = false, double* wallMs = nullptr);
+  // One frame: brings the caches up to date (with cacheBudgetMs > 0, at most about that much build time
+  // of the multiple-scattering cache, so a viewer refines it over frames and never waits for all of it:
+  // DeviceMsCache::refine; otherwise all of it), then one launch of the kernel, waited for. Returns its
+  // milliseconds by profiling event; wallMs, when not null, gets the wall clock around the launch.
+  double renderFrame(double cacheBudgetMs = 0, double* wallMs = nullptr);
   // The last frame read back (image, status, caches' statistics); stats.frames stays empty.
   RenderResult result();
   const RenderStats& stats() const { return stats_; }
@@ -71,6 +72,12 @@ class RealtimeRenderer {
   RenderStats stats_;
   std::vector<std::string> warnings_;
 };
+
+// What a frame with a budget of frameBudgetMs leaves the multiple-scattering cache after a frame that
+// took lastFrameMs: the rest, a quarter of the budget at least (the viewer and renderRealtime).
+inline double cacheBudgetMs(double frameBudgetMs, double lastFrameMs) {
+  return frameBudgetMs > 0 ? std::max(frameBudgetMs / 4, frameBudgetMs - lastFrameMs) : 0;
+}
 
 // Renders scene.renderer.algorithm ("raymarch" or "lobe") `frames` times (>= 1); the image is the
 // last frame (every frame is the same: the kernels are deterministic).

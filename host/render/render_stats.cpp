@@ -35,6 +35,7 @@ void addJson(nlohmann::json& j, const MsCacheStats& c) {
   j["ms_cache_cells"] = {c.cells[0], c.cells[1], c.cells[2]};
   j["ms_cache_layout"] = c.view ? "view" : "grid";
   j["ms_cache_paths"] = c.paths;
+  j["ms_cache_progress"] = c.progress;
   j["ms_cache_builds"] = c.builds;
   j["ms_cache_ms"] = c.ms;
   j["ms_cache_filter"] = c.filter;
@@ -94,6 +95,7 @@ std::string describe(const MsCacheStats& c) {
   line << "multiple-scattering cache: " << c.cells[0] << "x" << c.cells[1] << "x" << c.cells[2]
        << (c.view ? " columns x rows x slices, " : " cells, ") << (c.budgetMax > 0 ? "a mean of " : "") << c.paths
        << " paths per node";
+  if (c.progress < 1) line << " (" << int(c.progress * 100) << "% of the paths asked for)";
   if (c.filter > 0)
     line << ", filtered (sigma " << c.filter << " columns, tolerance " << c.filterTolerance << " standard errors"
          << (c.filterTwicing ? ", twiced" : "") << ")";

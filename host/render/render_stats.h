@@ -47,6 +47,7 @@ struct MsCacheStats {
   int cells[3] = {0, 0, 0};
   bool view = false;
   int paths = 0, builds = 0;
+  double progress = 0;  // the share of its paths built (below 1 while a budgeted build is under way)
   double ms = 0;
   float filter = 0, filterTolerance = 0;
   bool filterTwicing = false;

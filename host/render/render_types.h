@@ -39,6 +39,10 @@ struct RenderOptions {
   std::function<void(const struct RenderResult&)> snapshot;
   // pathtrace: build with -DCOUNTERS and report collision and lookup counts in RenderStats.
   bool counters = false;
+  // Real-time (renderRealtime): a frame's budget in ms (0: none). With one, the multiple-scattering
+  // cache is built over the frames in what each leaves of it (RealtimeRenderer::renderFrame), and a
+  // frame's wall time holds its share of the build.
+  double frameBudgetMs = 0;
 };
 
 struct RenderResult {

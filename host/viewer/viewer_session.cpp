@@ -213,9 +213,12 @@ void ViewerSession::renderFrame() {
     spp_ = r.samples();
   } else {
     RealtimeRenderer& r = realtime(view);
-    // A snapshot must be what `narval render` of its scene draws: the cache complete first.
-    ms = r.renderFrame(/*progressiveCache=*/!snapshot_);
+    // The multiple-scattering cache takes what the frame leaves of its budget (a quarter at least), so
+    // no frame waits for all of it; a snapshot must be what `narval render` of its scene draws: the
+    // cache complete first.
+    ms = r.renderFrame(snapshot_ ? 0 : cacheBudgetMs(options_.targetMs, lastMs_));
     result = r.result();
+    cacheProgress_ = result.stats.msCache.builds > 0 ? result.stats.msCache.progress : -1;
     if (snapshot_) result.mediumMask = r.mediumMask();
     spp_ = 1;
   }
@@ -271,6 +274,7 @@ void ViewerSession::compose(const ImageRGB& image) {
   std::vector<std::string> lines(std::begin(kHelp), std::end(kHelp));
   lines.push_back(algorithmName(algorithm_) + std::string("  ") + formatFixed(lastMs_, 1) + " MS  " + sizeName(lastWidth_, lastHeight_) + "  " +
                   std::to_string(spp_) + " SPP");
+  if (cacheProgress_ >= 0 && algorithm_ == Algorithm::Raymarch) lines.push_back("MS CACHE " + std::to_string(int(cacheProgress_ * 100)) + "%");
   if (liveError_.valid)
     lines.push_back("DE76 " + formatFixed(liveError_.meanDeltaE76, 2) + "  JND " + formatFixed(liveError_.jndPercent, 1) + "%");
   const int scale = fullW >= 960 ? 2 : 1, lineHeight = (kFontHeight + 3) * scale;
@@ -335,6 +339,8 @@ std::string ViewerSession::title() const {
   std::string t = "narval view: " + fs::path(scene_.sourcePath).filename().string() + " | " + algorithmName(algorithm_) + " | " +
                   formatFixed(lastMs_, 1) + " ms | " + sizeName(lastWidth_, lastHeight_) + " | " + std::to_string(spp_) +
                   " spp | " + rt_.selected.info.name;
+  if (cacheProgress_ >= 0 && algorithm_ == Algorithm::Raymarch)
+    t += " | ms cache " + std::to_string(int(cacheProgress_ * 100)) + "%";
   if (liveError_.valid)
     t += " | ΔE76 " + formatFixed(liveError_.meanDeltaE76, 2) + ", JND " + formatFixed(liveError_.jndPercent, 1) + "%";
   return t;

@@ -90,6 +90,7 @@ static inline void ms_view_filter_column(NV_PRIVATE const node_grid_params* c, N
         NV_GLOBAL const float* v = own + (size_t)s * slice_stride;
         float vj;
         read[s] = ms_view_filter_read(c, cache, v, j, &vj);
+        if (j == column) continue; /* its own distance is 0, whatever the reads: the weight's floor of 1 */
         const float diff = vec3_average(read[s]) - ms_view_grey(v);
         const float var = ms_view_grey_variance(v) + vj;
         d2 += nv_fmax(0.0f, diff * diff - var) / (MS_VIEW_FILTER_EPSILON + k2 * var);
@@ -102,7 +103,8 @@ static inline void ms_view_filter_column(NV_PRIVATE const node_grid_params* c, N
       }
       weight += w;
     }
-  for (int s = 0; s < nz; ++s) { /* weight ≥ 1: the column itself */
+  for (int s = 0; s < nz; ++s) { /* weight ≥ 1: the column itself (a node read across slices of no width,
+                                  * or noiseless with no paths yet, would otherwise be at a distance) */
     NV_GLOBAL float* o = out + (size_t)s * slice_stride;
     vec3 J = vec3_make(sum[s].x / weight, sum[s].y / weight, sum[s].z / weight);
     if (residual) {

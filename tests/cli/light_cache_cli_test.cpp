@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.h"
+#include "exr_bits.h"
 #include "image/image.h"
 
 namespace narval::test {
@@ -83,6 +84,39 @@ TEST_F(LightCacheCli, TheMultipleScatteringCacheIsBuiltOnceAndReported) {
   double sumCached = 0, sumPlain = 0;
   for (size_t i = 0; i < cached.rgb.size(); ++i) sumCached += cached.rgb[i], sumPlain += plain.rgb[i];
   EXPECT_GT(sumCached, sumPlain);  // light scattered more than once only adds
+}
+
+// --target-ms with --frames: the cache is built over the frames in what each leaves of the budget.
+// A budget below any launch (0.001 ms) gives each frame one slice (a node at least): after 2 frames
+// the cache is partly built, and the stats and the report say how much; after enough frames (5³ nodes,
+// sweeps of 1, 1, 2, 2 paths: at most 500 slices) the image is the unbudgeted render's, bit for bit.
+// Where the flag cannot apply: one line, exit 2, nothing written.
+TEST_F(LightCacheCli, ABudgetBuildsTheCacheOverTheFramesToTheSameImage) {
+  const std::string cache = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
+                            "--set renderer.raymarch.msCache.paths=6";
+  RunResult r = run("render s.json -o p.exr --frames 2 --target-ms 0.001 --stats-json p.json" + cache);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const double progress = stats("p.json")["ms_cache_progress"].get<double>();
+  EXPECT_GT(progress, 0.0);
+  EXPECT_LT(progress, 1.0);
+  EXPECT_NE(r.out.find("% of the paths asked for) in "), std::string::npos) << r.out;
+  r = run("render s.json -o b.exr --frames 1000 --target-ms 0.001 --stats-json b.json" + cache);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(stats("b.json")["ms_cache_progress"], 1.0);
+  EXPECT_EQ(stats("b.json")["ms_cache_paths"], 6);
+  ASSERT_EQ(run("render s.json -o a.exr" + cache).code, 0);
+  expectSameBits((dir_ / "a.exr").string(), (dir_ / "b.exr").string(), {"R", "G", "B"});
+
+  r = run("render s.json -o x.exr --target-ms 50");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "narval: --target-ms requires --frames (see narval --help)\n");
+  r = run("render s.json -o x.exr --frames 2 --target-ms 50 --algorithm pathtrace");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("\nnarval: --target-ms: only the real-time algorithms render frames in a budget; the algorithm "
+                       "is pathtrace\n"),
+            std::string::npos)
+      << r.err;  // after the scene's warning that its light cache does not apply
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x.exr"));
 }
 
 // The view layout: columns of 4x4 pixels over the 24x18 image (6 x 5, the last row 2 pixels tall),

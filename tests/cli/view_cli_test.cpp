@@ -27,7 +27,7 @@ class ViewCli : public CliFixture {
   void SetUp() override {
     ASSERT_EQ(std::system("command -v xvfb-run > /dev/null"), 0)
         << "xvfb-run is missing: scripts/setup.sh installs xvfb (the viewer's tests need a display)";
-    // The fog scene as the ray marcher with its multiple-scattering cache, refined in 4 launches.
+    // The fog scene as the ray marcher with its multiple-scattering cache, 64 paths a node.
     nlohmann::json scene = nlohmann::json::parse(fogSceneJson(64, 48, 12));
     scene["renderer"]["algorithm"] = "raymarch";
     scene["renderer"]["raymarch"] = {{"multipleScattering", "cache"},
@@ -45,7 +45,7 @@ TEST_F(ViewCli, SnapshotsAreWhatRenderDrawsFromTheirJson) {
         "frames 1\n"
         "drag left 25 -8\n"
         "frames 1\n"
-        "key P            # the cache has 2 of its 4 launches: P completes it first\n"
+        "key P            # a snapshot completes the cache first (here the budget already has)\n"
         "frames 1\n"
         "key 3\n"
         "scroll 1.5\n"

@@ -120,23 +120,6 @@ TEST(MsCache, WhiteFurnaceIsOneWithMiePhaseFunctions) {
   }
 }
 
-// A lit isotropic box (a point light above it, background 0.2): the cache's nodes after K paths.
-Scene litBox() {
-  return sceneFromJson(R"({
-    "materials": [
-      {"name": "bulb", "type": "emitter", "albedo": [5, 5, 5]},
-      {"name": "fog", "type": "volume", "scattering": [1.5, 1.5, 1.5], "absorption": [0.5, 0.5, 0.5], "density": 1}
-    ],
-    "primitives": [
-      {"name": "point", "type": "point", "transform": {"position": [0, 0, 3]}, "materialName": "bulb"},
-      {"name": "box", "type": "volume", "transform": {"scale": [1, 1, 1]}, "materialName": "fog"}
-    ],
-    "camera": {"position": [0, 0, -4], "lookAt": [0, 0, 0], "vfov": 30},
-    "renderer": {"resolution": [8, 8], "algorithm": "raymarch", "bounces": 20,
-                 "raymarch": {"multipleScattering": "cache", "msCache": {"resolution": 4}}},
-    "background": [0.2, 0.2, 0.2]
-  })");
-}
 
 // The cache's running means, after checking its status word.
 std::vector<float> runningMeans(const DeviceMsCache& cache, const ms_cache_params& params) {
@@ -174,6 +157,59 @@ TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
     ASSERT_EQ(viewOne[i + 3], 48.0f);
   }
   EXPECT_GT(placed, 0);
+}
+
+// A cache refined within a frame budget (DeviceMsCache::refine with budgetMs > 0), call after call as
+// the viewer refines it, until it holds `paths`: its running means and what the march reads, the
+// calls it took and its build launches.
+struct BudgetedCache {
+  std::vector<float> means, read;
+  int calls = 0, launches = 0;
+};
+BudgetedCache budgetedCache(const Scene& scene, int paths, double budgetMs) {
+  DeviceSceneBuffers dev(runtime(), scene, nullptr);
+  const ms_cache_params params = realtimeParams(scene, dev.scene).msCache;
+  DeviceMsCache cache;
+  BudgetedCache out;
+  double done = 0;
+  do {
+    cache.refine(runtime(), dev, params, paths, 32, "lit_box.json", {}, budgetMs);
+    EXPECT_GE(cache.pathsDone(), done);  // never backwards
+    done = cache.pathsDone();
+    ++out.calls;
+  } while ((cache.paths() < paths || cache.filterPending()) && out.calls < 100000);
+  EXPECT_EQ(cache.paths(), paths);
+  EXPECT_EQ(cache.pathsDone(), paths);
+  out.means = runningMeans(cache, params);
+  out.read.resize(out.means.size());
+  runtime().queue.enqueueReadBuffer(cache.buffer(), CL_TRUE, 0, out.read.size() * sizeof(float), out.read.data());
+  out.launches = cache.launches();
+  return out;
+}
+
+// Refinement that never freezes a frame: with a budget of 0.01 ms a call (less than any launch), every
+// call adds one slice of the placement, the paths or the filtered copy (a node, a column, at least),
+// so the cache is built over hundreds of calls, in sweeps of 1, 1, 2, 4, ... paths per node. A node's
+// paths and their order do not depend on the slices, so the result is the one-go cache's, bit for bit:
+// the running means and what the march reads (the view layout's filtered, twiced copy included), in
+// both layouts.
+TEST(MsCache, BudgetedRefinementInAnySlicesGivesTheSameBits) {
+  Scene grid = litBox(), view = litBox();
+  view.renderer.raymarch.msCache.layout = MsCacheLayout::View;
+  view.renderer.raymarch.msCache.tile = 1;
+  view.renderer.raymarch.msCache.filter = 1.5f;
+  view.renderer.raymarch.msCache.filterTolerance = 2.0f;
+  view.renderer.raymarch.msCache.filterTwicing = true;
+  for (const Scene* scene : {&grid, &view}) {
+    SCOPED_TRACE(scene == &grid ? "grid layout" : "view layout, filtered and twiced");
+    const BudgetedCache one = budgetedCache(*scene, 24, 0), sliced = budgetedCache(*scene, 24, 0.01);
+    EXPECT_EQ(one.calls, 1);
+    EXPECT_EQ(one.launches, 1);  // 24 paths (at most 32 a launch) over every node
+    EXPECT_GT(sliced.calls, 50);
+    EXPECT_GT(sliced.launches, 50);
+    EXPECT_EQ(sliced.means, one.means);
+    EXPECT_EQ(sliced.read, one.read);
+  }
 }
 
 // The perceptual allocation (render/ms_cache_allocation.h) on the lit box's view cache (tile 1, 8x8

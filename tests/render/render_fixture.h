@@ -25,6 +25,25 @@ inline ClRuntime& runtime() {
 
 inline Scene sceneFromJson(const std::string& json) { return parseScene(json, "test_scene.json"); }
 
+// A lit isotropic box (a point light above it, background 0.2), drawn by the ray marcher with its
+// multiple-scattering cache at 4 cells: the cache's tests' scene.
+inline Scene litBox() {
+  return sceneFromJson(R"({
+    "materials": [
+      {"name": "bulb", "type": "emitter", "albedo": [5, 5, 5]},
+      {"name": "fog", "type": "volume", "scattering": [1.5, 1.5, 1.5], "absorption": [0.5, 0.5, 0.5], "density": 1}
+    ],
+    "primitives": [
+      {"name": "point", "type": "point", "transform": {"position": [0, 0, 3]}, "materialName": "bulb"},
+      {"name": "box", "type": "volume", "transform": {"scale": [1, 1, 1]}, "materialName": "fog"}
+    ],
+    "camera": {"position": [0, 0, -4], "lookAt": [0, 0, 0], "vfov": 30},
+    "renderer": {"resolution": [8, 8], "algorithm": "raymarch", "bounces": 20,
+                 "raymarch": {"multipleScattering": "cache", "msCache": {"resolution": 4}}},
+    "background": [0.2, 0.2, 0.2]
+  })");
+}
+
 // An n³ grid of density 1 in the voxels x0 <= x < x1 (every y and z), 0 elsewhere.
 inline DenseGrid xSlabGrid(int n, int x0, int x1) {
   DenseGrid g;
