@@ -19,6 +19,7 @@
 #include "render/pathtrace_renderer.h"
 #include "render/realtime_renderer.h"
 #include "render/render_common.h"
+#include "render/ms_cache_file.h"
 #include "render/render_exr.h"
 #include "shared/structs.h"
 
@@ -33,7 +34,7 @@ struct RenderArgs {
   bool resume = false, counters = false, quiet = false;
   std::optional<double> exposure;
   std::string tonemap;
-  std::string majorant = "auto", storage, displayServer;
+  std::string majorant = "auto", storage, displayServer, msCacheIn, msCacheOut;
   double partialEverySeconds = 0, targetMs = 0;
   long long seed = -1;
   std::vector<std::string> sets;
@@ -84,6 +85,10 @@ void refuseFlagsThatDoNotApply(const RenderArgs& a, const Scene& scene) {
   if (a.targetMs > 0 && !isRealtime(scene.renderer.algorithm))
     throw inputError("--target-ms", "", "only the real-time algorithms render frames in a budget; the algorithm is " +
                                             std::string(algorithmName(scene.renderer.algorithm)));
+  const bool msCache = scene.renderer.algorithm == Algorithm::Raymarch &&
+                       scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache;
+  for (const auto& [flag, value] : {std::pair{"--ms-cache-in", &a.msCacheIn}, {"--ms-cache-out", &a.msCacheOut}})
+    if (!value->empty() && !msCache) throw msCacheFlagWithoutCache(flag);
   if (!isRealtime(scene.renderer.algorithm)) return;
   const std::string algorithm = algorithmName(scene.renderer.algorithm);
   const std::string frames = "does not apply to " + algorithm + ", which renders frames (use --frames)";
@@ -106,7 +111,7 @@ void refuseFlagsThatDoNotApply(const RenderArgs& a, const Scene& scene) {
 // any work (folders made as the writers would make them).
 struct OutputPaths {
   fs::path exr, png;
-  std::string statsJson;
+  std::string statsJson, msCache;
 };
 
 OutputPaths outputPaths(const RenderArgs& a) {
@@ -118,6 +123,8 @@ OutputPaths outputPaths(const RenderArgs& a) {
   checkOutputWritable(o.exr.string(), "-o");
   checkOutputWritable(o.png.string(), "-o");
   checkOutputWritable(o.statsJson, "--stats-json");
+  o.msCache = a.msCacheOut;
+  checkOutputWritable(o.msCache, "--ms-cache-out");
   return o;
 }
 
@@ -197,8 +204,10 @@ class Snapshots {
 };
 
 // The EXR, the PNG and the stats land together or not at all (staged_files.h).
-void writeOutputs(const OutputPaths& o, const RenderResult& r, const Scene& scene, int frames) {
+void writeOutputs(const OutputPaths& o, const RenderResult& r, const Scene& scene, int frames,
+                  const MsCacheSnapshot& msCache) {
   StagedFiles staged;
+  if (!o.msCache.empty()) writeMsCacheFile(staged.stage(o.msCache), {msCacheSettings(scene), msCache});
   writeRenderExr(staged.stage(o.exr.string()), r, renderIdentity(scene));
   writePng(staged.stage(o.png.string()), r.image, scene.renderer.exposure, scene.renderer.toneMapping);
   if (!o.statsJson.empty()) {
@@ -282,6 +291,12 @@ int runRender(const RenderArgs& a) {
   options.majorantResolution = resume.majorantResolution;
   options.counters = a.counters;
   options.frameBudgetMs = a.targetMs;
+  MsCacheSnapshot cacheIn, cacheOut;
+  if (!a.msCacheIn.empty()) {
+    cacheIn = readMsCacheFile(a.msCacheIn, "--ms-cache-in", scene).snapshot;
+    options.msCacheIn = &cacheIn;
+  }
+  if (!a.msCacheOut.empty()) options.msCacheOut = &cacheOut;
   snapshots.install(options);
   const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)
                                   : renderPathtrace(rt, scene, g, options);
@@ -292,7 +307,7 @@ int runRender(const RenderArgs& a) {
     std::cerr << "narval: interrupted before the first " << (realtime ? "frame" : "pass") << "; nothing written\n";
     return kExitInterrupted;
   }
-  writeOutputs(out, r, scene, a.frames);
+  writeOutputs(out, r, scene, a.frames, cacheOut);
   return reportOutcome(a, out, r.stats, realtime, report);
 }
 
@@ -324,6 +339,11 @@ Command addRenderCommand(CLI::App& app) {
                   "Real-time, with --frames: a frame's budget, as the viewer's; the multiple-scattering cache is "
                   "built over the frames in what each leaves of it (the image is the last frame's)")
       ->check(greaterThanZero());
+  sub->add_option("--ms-cache-out", a->msCacheOut,
+                  "raymarch: write the multiple-scattering cache as built to FILE, for --ms-cache-in");
+  sub->add_option("--ms-cache-in", a->msCacheIn,
+                  "raymarch: start the multiple-scattering cache from FILE (--ms-cache-out of the same scene and "
+                  "cache settings; another camera pose where the cache does not depend on it)");
   sub->add_option("--stats-json", a->statsJson, "Write render statistics as JSON");
   sub->add_option("--storage", a->storage,
                   "Density grid on the device: image (3D image, hardware sampler), buffer (float buffer, the "

@@ -11,6 +11,7 @@
 #include "core/input_error.h"
 #include "image/image.h"
 #include "viewer/viewer_input.h"
+#include "render/ms_cache_file.h"
 #include "viewer/viewer_session.h"
 #include "viewer/viewer_window.h"
 
@@ -21,7 +22,7 @@ namespace {
 
 struct ViewArgs {
   std::string scene, algorithm, device, reference, resolution, script, screenshot, outputDir = "out", statsJson;
-  std::string localSize = "8x8";
+  std::string localSize = "8x8", msCacheIn;
   std::vector<std::string> sets;
   double targetMs = 50;
   int frames = 0;
@@ -96,6 +97,13 @@ int runView(const ViewArgs& a) {
     options.reference = &reference;
     options.referenceName = a.reference;
   }
+  MsCacheSnapshot cacheIn;
+  if (!a.msCacheIn.empty()) {
+    if (scene.renderer.raymarch.multipleScattering != MultipleScattering::Cache)
+      throw msCacheFlagWithoutCache("--ms-cache-in");
+    cacheIn = readMsCacheFile(a.msCacheIn, "--ms-cache-in", scene).snapshot;
+    options.msCacheIn = &cacheIn;
+  }
   options.targetMs = a.targetMs;
   options.outputDir = a.outputDir;
   options.render.localSizeX = lx;
@@ -136,6 +144,9 @@ Command addViewCommand(CLI::App& app) {
                   "takes about this long, and build the multiple-scattering cache in the time a frame leaves "
                   "(default 50)")
       ->check(greaterThanZero());
+  sub->add_option("--ms-cache-in", a->msCacheIn,
+                  "Start the ray marcher's multiple-scattering cache from FILE (narval render --ms-cache-out of the "
+                  "same scene and cache settings)");
   sub->add_option("--script", a->script,
                   "Replay the inputs in FILE instead of a user (key, drag, scroll, hold, frames; docs/viewer.md)");
   sub->add_option("--frames", a->frames, "Stop after N frames (default with --script: the script's frames)")

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cl/device_allocation.h"
+#include "core/input_error.h"
 #include "render/majorant_options.h"
 #include "render/node_grid_layout.h"
 #include "render/render_common.h"
@@ -71,6 +72,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     ++rebuilds_;
     key_ = key;
     placed_ = view ? 0 : size_t(-1);  // the view nodes' places, first (place())
+    if (restorePending_) restore(rt);
   }
   budgeted_ = budgetMs > 0;
   budgetLeftMs_ = budgetMs;
@@ -85,6 +87,36 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   }
   if (paths_ < launches) addPaths(rt, dev, params, launches, pathsPerLaunch);
   if (filterOn_) filter(rt, params);
+}
+
+MsCacheSnapshot DeviceMsCache::snapshot(ClRuntime& rt) const {
+  MsCacheSnapshot s;
+  s.nodes.resize(bytes_ / sizeof(float));
+  if (!s.nodes.empty()) rt.queue.enqueueReadBuffer(buffer_, CL_TRUE, 0, bytes_, s.nodes.data());
+  s.paths = paths_;
+  s.sweepPaths = sweepPaths_;
+  s.budgetMin = budgetMin_;
+  s.budgetMax = budgetMax_;
+  s.sweepNode = sweepNode_;
+  s.placed = placed_ == size_t(-1) ? UINT64_MAX : uint64_t(placed_);
+  return s;
+}
+
+// The pending snapshot into the cache just started (refine's start-over).
+void DeviceMsCache::restore(ClRuntime& rt) {
+  restorePending_ = false;
+  if (restore_.nodes.size() * sizeof(float) != bytes_)
+    throw InputError("the multiple-scattering cache to restore holds " +
+                     std::to_string(restore_.nodes.size() / MS_CACHE_STRIDE) + " nodes; this scene's has " +
+                     std::to_string(bytes_ / (MS_CACHE_STRIDE * sizeof(float))));
+  rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, restore_.nodes.data());
+  paths_ = restore_.paths;
+  sweepPaths_ = restore_.sweepPaths;
+  budgetMin_ = restore_.budgetMin;
+  budgetMax_ = restore_.budgetMax;
+  sweepNode_ = size_t(restore_.sweepNode);
+  placed_ = restore_.placed == UINT64_MAX ? size_t(-1) : size_t(restore_.placed);
+  restore_ = MsCacheSnapshot{};
 }
 
 double DeviceMsCache::pathsDone() const {

@@ -4,6 +4,7 @@
 // over only when the medium, grid, lights, bounces, seed, background or layout change.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,13 @@
 #include "shared/structs.h"
 
 namespace narval {
+
+// A cache's nodes and progress, as read back for a file (render/ms_cache_file.h) and restored from one.
+struct MsCacheSnapshot {
+  std::vector<float> nodes;  // MS_CACHE_STRIDE floats per node (ms_cache.h, "Storage")
+  int paths = 0, sweepPaths = 0, budgetMin = 0, budgetMax = 0;
+  uint64_t sweepNode = 0, placed = 0;  // the sweep under way; the view layout's columns placed
+};
 
 class DeviceMsCache {
  public:
@@ -30,6 +38,12 @@ class DeviceMsCache {
   void refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params, int targetPaths,
               int pathsPerLaunch, const std::string& sceneFile, const MsCacheAllocation& allocation = {},
               double budgetMs = 0);
+  // The nodes and progress so far (one read-back).
+  MsCacheSnapshot snapshot(ClRuntime& rt) const;
+  // The next start (the first refine) takes `snapshot` for its nodes and progress instead of zeros: a
+  // cache built before, for the same scene and settings (the caller checks them: ms_cache_file.h); the
+  // refine goes on from its paths. InputError when its node count is not the start's.
+  void restoreAtStart(MsCacheSnapshot snapshot) { restore_ = std::move(snapshot); restorePending_ = true; }
   // What the march reads: the running means or, with the view layout's filter (params.filter > 0;
   // kernels/shared/ms_cache_filter.h), their filtered copy, twiced when params.filter_twicing is set.
   // A budgeted refine makes the filtered copy over several calls; until the first is done, the means.
@@ -55,6 +69,7 @@ class DeviceMsCache {
   // The filtered copy, when the paths or settings changed (budgeted: continued over calls).
   void filter(ClRuntime& rt, const ms_cache_params& params);
   bool place(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params);
+  void restore(ClRuntime& rt);
   // Budgeted slices (device_ms_cache.cpp).
   size_t activeBefore(size_t n) const;
   size_t sliceEnd(size_t first, size_t end, double units) const;
@@ -67,6 +82,8 @@ class DeviceMsCache {
   void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);
 
   std::string key_;
+  MsCacheSnapshot restore_;
+  bool restorePending_ = false;
   AllocationSite site_;  // what an allocation failure names (the scene file and key)
   cl::Program program_;
   std::string programOptions_;

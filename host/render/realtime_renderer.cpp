@@ -173,6 +173,7 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, SceneGrids grid, 
                             const RenderOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   RealtimeRenderer renderer(rt, scene, grid, options);
+  if (options.msCacheIn) renderer.restoreMsCache(*options.msCacheIn);
   rt.queue.finish();
   const double buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -199,6 +200,7 @@ RenderResult renderRealtime(ClRuntime& rt, const Scene& scene, SceneGrids grid, 
   }
   RenderResult result = renderer.result();
   result.mediumMask = renderer.mediumMask();
+  if (options.msCacheOut) *options.msCacheOut = renderer.msCacheSnapshot();
   RenderStats& st = result.stats;
   st.buildSeconds = buildSeconds;
   st.interrupted = int(kernelMs.size()) < requested;

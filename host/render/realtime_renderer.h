@@ -47,6 +47,10 @@ class RealtimeRenderer {
   // The last frame read back (image, status, caches' statistics); stats.frames stays empty.
   RenderResult result();
   const RenderStats& stats() const { return stats_; }
+  // The multiple-scattering cache: started from a snapshot at the first frame (DeviceMsCache::
+  // restoreAtStart), or read back as it is.
+  void restoreMsCache(MsCacheSnapshot snapshot) { msCache_.restoreAtStart(std::move(snapshot)); }
+  MsCacheSnapshot msCacheSnapshot() { return msCache_.snapshot(rt_); }
   const std::vector<std::string>& warnings() const { return warnings_; }
   const DeviceScene& deviceScene() const { return dev_.scene; }
   // The current camera's medium mask (render/medium_mask.h): what an EXR of the image holds beside

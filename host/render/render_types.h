@@ -43,6 +43,10 @@ struct RenderOptions {
   // cache is built over the frames in what each leaves of it (RealtimeRenderer::renderFrame), and a
   // frame's wall time holds its share of the build.
   double frameBudgetMs = 0;
+  // raymarch with the multiple-scattering cache: start it from this snapshot (ms_cache_file.h, read and
+  // checked by the caller) and/or give the cache as the last frame read it.
+  const struct MsCacheSnapshot* msCacheIn = nullptr;
+  struct MsCacheSnapshot* msCacheOut = nullptr;
 };
 
 struct RenderResult {

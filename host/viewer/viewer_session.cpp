@@ -166,6 +166,7 @@ RealtimeRenderer& ViewerSession::realtime(const Scene& view) {
     full.renderer.width = scene_.renderer.width;
     full.renderer.height = scene_.renderer.height;
     r = std::make_unique<RealtimeRenderer>(rt_, full, grid_, options_.render);
+    if (options_.msCacheIn && algorithm_ == Algorithm::Raymarch) r->restoreMsCache(*options_.msCacheIn);
     for (const std::string& w : r->warnings()) messages_.push_back("warning: " + w);
   }
   r->setView(view);

@@ -31,6 +31,7 @@ struct ViewerOptions {
   const ImageRGB* reference = nullptr;  // --reference: compared while the camera is at the scene's pose
   std::string referenceName;
   RenderOptions render;                 // work-group shape, majorant (as `narval render` takes them)
+  const MsCacheSnapshot* msCacheIn = nullptr;  // --ms-cache-in: the ray marcher's cache starts from it
 };
 
 class ViewerSession {

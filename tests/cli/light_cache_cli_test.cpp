@@ -1,6 +1,9 @@
 // renderer.lightCache as a user drives it: --stats-json reports the cache (cells, bytes, slabs built,
 // build time apart from the frames), --frames K builds it once, a light moved with --set changes the
 // image and is built anew, and bad values are one line with exit 2 before any rendering.
+#include <cmath>
+#include <filesystem>
+
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.h"
@@ -117,6 +120,74 @@ TEST_F(LightCacheCli, ABudgetBuildsTheCacheOverTheFramesToTheSameImage) {
             std::string::npos)
       << r.err;  // after the scene's warning that its light cache does not apply
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.exr"));
+}
+
+// --ms-cache-out and --ms-cache-in (render/ms_cache_file.h). The grid layout's cache does not depend
+// on the camera (its paths start uniformly on the sphere at world-space nodes), so a cache built at
+// the scene's pose and read at poses orbited 5°, 30° and 90° about the look-at point gives, with no
+// build at all, the very image a cache built there gives, bit for bit. A cache of 4 paths read
+// with `paths` 8 goes on to 8 and equals a cache built to 8 in one go.
+TEST_F(LightCacheCli, ACacheFileBuiltAtOnePoseDrawsAnother) {
+  const std::string cache = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
+                            "--set renderer.raymarch.msCache.paths=";
+  ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out baked/a.mscache" + cache + "4").code, 0);
+  ASSERT_TRUE(std::filesystem::exists(dir_ / "baked/a.mscache"));  // its folder made
+  for (const double degrees : {5.0, 30.0, 90.0}) {
+    SCOPED_TRACE(degrees);
+    const double r = degrees * 3.14159265358979 / 180;
+    const std::string pose = " --set camera.position=[" + std::to_string(6 * std::sin(r)) + ",0," +
+                             std::to_string(-6 * std::cos(r)) + "]";
+    RunResult read = run("render s.json -o read.exr --stats-json read.json --ms-cache-in baked/a.mscache" + cache + "4" + pose);
+    ASSERT_EQ(read.code, 0) << read.err;
+    EXPECT_EQ(stats("read.json")["ms_cache_ms"], 0.0);  // nothing built
+    ASSERT_EQ(run("render s.json -o built.exr" + cache + "4" + pose).code, 0);
+    expectSameBits((dir_ / "built.exr").string(), (dir_ / "read.exr").string(), {"R", "G", "B"});
+  }
+  ASSERT_EQ(run("render s.json -o more.exr --stats-json more.json --ms-cache-in baked/a.mscache" + cache + "8").code, 0);
+  EXPECT_EQ(stats("more.json")["ms_cache_paths"], 8);
+  ASSERT_EQ(run("render s.json -o eight.exr" + cache + "8").code, 0);
+  expectSameBits((dir_ / "eight.exr").string(), (dir_ / "more.exr").string(), {"R", "G", "B"});
+}
+
+// A cache file is refused, one line naming the first setting that differs, exit 2, nothing written,
+// for another medium, another light, another cache setting, and (the view layout aiming its paths at
+// the camera) another pose; so are what is not a cache file and the flags where no cache is drawn.
+TEST_F(LightCacheCli, ACacheFileIsRefusedForAnotherSceneNamingWhatDiffers) {
+  const std::string grid = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
+                           "--set renderer.raymarch.msCache.paths=2";
+  const std::string view = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\" "
+                           "--set renderer.raymarch.msCache.paths=2";
+  ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out g.mscache" + grid).code, 0);
+  ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out v.mscache" + view).code, 0);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--ms-cache-in g.mscache" + grid + " --set materials.2.density=5",
+       "narval: --ms-cache-in: g.mscache: built for another scene or cache setting (materials[2].density is 6 in "
+       "g.mscache, 5 in the scene)\n"},
+      {"--ms-cache-in g.mscache" + grid + " --set primitives.1.transform.position=[-2,2,-2]",
+       "narval: --ms-cache-in: g.mscache: built for another scene or cache setting (primitives[1].transform.position[2] "
+       "is -1 in g.mscache, -2 in the scene)\n"},
+      {"--ms-cache-in g.mscache" + grid + " --set renderer.raymarch.msCache.resolution=8",
+       "narval: --ms-cache-in: g.mscache: built for another scene or cache setting (renderer.raymarch.msCache.resolution "
+       "is 4 in g.mscache, 8 in the scene)\n"},
+      {"--ms-cache-in v.mscache" + view + " --set camera.position=[1,0,-6]",
+       "narval: --ms-cache-in: v.mscache: built for another scene or cache setting (camera.position[0] is 0 in "
+       "v.mscache, 1 in the scene)\n"},
+      {"--ms-cache-in s.json" + grid,
+       "narval: --ms-cache-in: s.json: not a multiple-scattering cache (narval render --ms-cache-out writes one)\n"},
+      {"--ms-cache-in g.mscache --algorithm lobe",
+       "narval: --ms-cache-in: only the ray marcher's multiple-scattering cache is kept in a file; the scene has none "
+       "(algorithm raymarch, renderer.raymarch.multipleScattering \"cache\")\n"},
+      {"--ms-cache-out o.mscache",
+       "narval: --ms-cache-out: only the ray marcher's multiple-scattering cache is kept in a file; the scene has none "
+       "(algorithm raymarch, renderer.raymarch.multipleScattering \"cache\")\n"},
+  };
+  for (const auto& [flags, message] : cases) {
+    const RunResult r = run("render s.json -o x.exr " + flags);
+    EXPECT_EQ(r.code, 2) << flags;
+    EXPECT_EQ(r.err, message) << flags;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x.exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "o.mscache"));
 }
 
 // The view layout: columns of 4x4 pixels over the 24x18 image (6 x 5, the last row 2 pixels tall),

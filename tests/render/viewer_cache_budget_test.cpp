@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "render/device_ms_cache.h"
 #include "render_fixture.h"
 #include "viewer/viewer_session.h"
 
@@ -45,6 +46,24 @@ TEST(ViewerCacheBudget, TheTitleShowsTheCacheFillingFrameByFrame) {
   session.apply(lobe);
   session.renderFrame();
   EXPECT_EQ(cachePercent(session.title()), -1) << session.title();
+}
+
+// A cache read at the start (--ms-cache-in: a snapshot of one `narval render` built) is whole at the
+// first frame, whatever the budget: nothing is left to build.
+TEST(ViewerCacheBudget, ARestoredCacheIsWholeAtTheFirstFrame) {
+  Scene scene = litBox();
+  scene.renderer.raymarch.msCache.paths = 16;
+  MsCacheSnapshot baked;
+  RenderOptions bake;
+  bake.msCacheOut = &baked;
+  renderRealtime(runtime(), scene, nullptr, 1, bake);
+  EXPECT_EQ(baked.paths, 16);
+  ViewerOptions options;
+  options.targetMs = 0.001;
+  options.msCacheIn = &baked;
+  ViewerSession session(runtime(), scene, nullptr, options);
+  session.renderFrame();
+  EXPECT_EQ(cachePercent(session.title()), 100) << session.title();
 }
 
 }  // namespace
