@@ -41,18 +41,25 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   twicingOn_ = filterOn_ && params.filter_twicing;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   if (key != key_) {
+    // Started over with as many nodes as before (a light, the medium or a view cache's camera changed),
+    // the old nodes are drawn until each takes its first new path, which replaces all that a lookup
+    // reads (the running mean's first step sets it; ms_cache_build.h): the picture is refreshed
+    // progressively, not thrown away, and the cache ends as one built from nothing, bit for bit.
+    const bool keep = buffer_() && nodes * MS_CACHE_STRIDE * sizeof(float) == bytes_;
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
     site_ = AllocationSite{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
                                   "x" + std::to_string(c.nz) + " nodes"};
-    buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
-    front_ = back_ = mid_ = cl::Buffer();  // allocated by the filter when it is on
+    if (!keep) {
+      buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+      rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
+      front_ = back_ = mid_ = cl::Buffer();  // allocated by the filter when it is on
+      frontReady_ = false;                   // (a kept front is the old filtered copy, drawn meanwhile)
+    }
     filteredKey_.clear();
     filteredPaths_ = -1;
-    frontReady_ = false;
     filterPass_ = 0;
     activePrefix_.clear();
-    rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
     if (dev.buildOptions() != programOptions_) {  // kept across start-overs (a view cache's camera moves)
       programOptions_ = dev.buildOptions();
       program_ = buildProgram(rt, "ms_cache.cl", programOptions_);

@@ -118,6 +118,13 @@ static inline int ms_cache_node_is_read(KERNEL_CONTEXT_PARAM, NV_PRIVATE const n
   return 0;
 }
 
+/* The running mean of k + 1 values from that of the first k and the next, x: the first sets it (so a
+ * node started over in place, its old value drawn until then, holds exactly what a zeroed one would:
+ * device_ms_cache.cpp). */
+static inline float ms_cache_running_mean(float mean, float x, uint k) {
+  return k == 0u ? x : mean + (x - mean) / (float)(k + 1u);
+}
+
 /* Adds paths [first, first + count) to the running means of node `node` at world point x (ms_cache.h,
  * "Storage": v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch), then ln R and b/R. */
 static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, vec3 x,
@@ -127,16 +134,15 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
   for (uint k = first; k < first + count; ++k) {
     vec3 omega;
     const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, mc, node, v, x, keys, k, &omega);
-    const float n = (float)(k + 1u);
     const float Lc[3] = {L.x, L.y, L.z};
     const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */
     const float grey = vec3_average(L);
-    v[MS_CACHE_SQUARE] += (grey * grey - v[MS_CACHE_SQUARE]) / n;
+    v[MS_CACHE_SQUARE] = ms_cache_running_mean(v[MS_CACHE_SQUARE], grey * grey, k);
     for (int ch = 0; ch < 3; ++ch) {
-      v[ch] += (Lc[ch] - v[ch]) / n;
-      for (int a = 0; a < 3; ++a) v[4 + 4 * ch + a] += (Lc[ch] * w[a] - v[4 + 4 * ch + a]) / n;
+      v[ch] = ms_cache_running_mean(v[ch], Lc[ch], k);
+      for (int a = 0; a < 3; ++a) v[4 + 4 * ch + a] = ms_cache_running_mean(v[4 + 4 * ch + a], Lc[ch] * w[a], k);
     }
-    v[3] = n;
+    v[3] = (float)(k + 1u);
   }
   /* What the lookup reads (ms_cache.h, "Storage"). */
   for (int ch = 0; ch < 3; ++ch) {

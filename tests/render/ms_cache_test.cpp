@@ -212,6 +212,38 @@ TEST(MsCache, BudgetedRefinementInAnySlicesGivesTheSameBits) {
   }
 }
 
+// A light moved 10° (about the box's centre) starts the cache over in place, refreshed within a frame
+// budget: after the first call (one slice of nodes) the nodes it reached hold the new light's first
+// path and the others still the old light's 24 paths, drawn meanwhile (not 0, as a cache thrown away
+// would be); once every node has its paths again, the cache is the one built there from nothing, bit for bit.
+TEST(MsCache, AMovedLightIsRefreshedProgressivelyToTheCacheBuiltThere) {
+  const Scene before = litBox();
+  Scene after = before;
+  const double turn = 10 * 3.14159265358979 / 180;
+  after.primitives[0].transform.position = {float(3 * std::sin(turn)), 0, float(3 * std::cos(turn))};
+  DeviceSceneBuffers devBefore(runtime(), before, nullptr), devAfter(runtime(), after, nullptr);
+  const ms_cache_params params = realtimeParams(before, devBefore.scene).msCache;
+  DeviceMsCache cache;
+  while (cache.paths() < 24) cache.refine(runtime(), devBefore, params, 24, 32, "before", {}, 0.01);
+  const std::vector<float> old = runningMeans(cache, params);
+  cache.refine(runtime(), devAfter, params, 24, 32, "after", {}, 0.01);
+  EXPECT_EQ(cache.rebuilds(), 2);
+  const std::vector<float> partial = runningMeans(cache, params);
+  int kept = 0, refreshed = 0;
+  for (size_t n = 0; n < old.size(); n += MS_CACHE_STRIDE) {
+    ASSERT_TRUE(partial[n + 3] == 24.0f || partial[n + 3] == 1.0f) << "node " << n / MS_CACHE_STRIDE;
+    (partial[n + 3] == 24.0f ? kept : refreshed) += 1;  // the count: the old cache's 24, or the new sweep's 1
+    if (partial[n + 3] == 24.0f) ASSERT_EQ(partial[n], old[n]);
+  }
+  EXPECT_GT(kept, 0);
+  EXPECT_GT(refreshed, 0);
+  for (int calls = 0; cache.paths() < 24 && calls < 100000; ++calls)
+    cache.refine(runtime(), devAfter, params, 24, 32, "after", {}, 0.01);
+  const std::vector<float> refreshedMeans = runningMeans(cache, params), scratch = cacheAfter(after, 24, 32);
+  for (size_t i = 0; i < scratch.size(); ++i)
+    ASSERT_EQ(refreshedMeans[i], scratch[i]) << "node " << i / MS_CACHE_STRIDE << ", slot " << i % MS_CACHE_STRIDE;
+}
+
 // The perceptual allocation (render/ms_cache_allocation.h) on the lit box's view cache (tile 1, 8x8
 // columns, a mean of 48 paths): every node first takes the pilot (12), then its column's budget.
 // Built in one call and as a viewer builds it (one launch of 5 mean paths a call, until paths()
