@@ -252,10 +252,10 @@ void DeviceMsCache::countActive(ClRuntime& rt, const ms_cache_params& params) {
 }
 
 // The units a budgeted slice of cost `msPerUnit` each can take with the budget left (`pilot` before
-// anything was measured), growing at most fourfold from the last (costs vary across the medium).
+// anything was measured), growing at most twofold from the last (costs vary across the medium).
 double DeviceMsCache::unitsThatFit(double msPerUnit, double pilot, size_t lastUnits) const {
   double units = msPerUnit > 0 ? budgetLeftMs_ / msPerUnit : pilot;
-  if (lastUnits > 0) units = std::min(units, 4.0 * double(lastUnits));
+  if (lastUnits > 0) units = std::min(units, 2.0 * double(lastUnits));
   return units;
 }
 
