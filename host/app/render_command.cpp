@@ -265,6 +265,8 @@ int runRender(const RenderArgs& a) {
     return 0;
   }
   Snapshots snapshots(a, scene, out.exr);
+  MsCacheSnapshot cacheIn, cacheOut;  // read and checked before the grids load
+  if (!a.msCacheIn.empty()) cacheIn = readMsCacheFile(a.msCacheIn, "--ms-cache-in", scene).snapshot;
 
   // Everything the render needs is loaded and checked before the first sample.
   SceneGridStorage gridStorage;
@@ -291,11 +293,7 @@ int runRender(const RenderArgs& a) {
   options.majorantResolution = resume.majorantResolution;
   options.counters = a.counters;
   options.frameBudgetMs = a.targetMs;
-  MsCacheSnapshot cacheIn, cacheOut;
-  if (!a.msCacheIn.empty()) {
-    cacheIn = readMsCacheFile(a.msCacheIn, "--ms-cache-in", scene).snapshot;
-    options.msCacheIn = &cacheIn;
-  }
+  if (!a.msCacheIn.empty()) options.msCacheIn = &cacheIn;
   if (!a.msCacheOut.empty()) options.msCacheOut = &cacheOut;
   snapshots.install(options);
   const RenderResult r = realtime ? renderRealtime(rt, scene, g, std::max(1, a.frames), options)
