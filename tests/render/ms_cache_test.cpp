@@ -159,6 +159,30 @@ TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
   EXPECT_GT(placed, 0);
 }
 
+// What a frame draws while a budgeted cache is partly built: the furnace's view cache holding the
+// direct light, filtered and twiced, after 2 and 4 frames of a 0.001 ms budget (a slice a frame), in
+// a thin medium (optical depth 0.02: the slices' levels past it collapse onto the column's end) and a
+// dense one. Nodes of no paths sit beside nodes of some, noiseless (every path is 1 here), as the
+// filter's own test builds them by hand (MsCacheFilter.ASliceOfNoWidthBesideANodeOfNoPathsStaysFinite).
+// Every pixel finite, the status clean, the cache partly built.
+TEST(MsCache, APartlyBuiltCacheDrawsFinitePixels) {
+  const std::string view = R"("layout": "view", "tile": 1, "slices": 8, "direct": true, "filter": 1.5,
+                              "filterTolerance": 2, "filterTwicing": true)";
+  for (const double density : {0.01, 1.0})
+    for (const int frames : {2, 4}) {  // the first places the columns, each next adds a slice of nodes
+      SCOPED_TRACE("density " + std::to_string(density) + ", " + std::to_string(frames) + " frames");
+      RenderOptions budget;
+      budget.frameBudgetMs = 0.001;
+      const RenderResult r =
+          renderRealtime(runtime(), sceneFromJson(furnaceJson("cache", density, view)), nullptr, frames, budget);
+      EXPECT_EQ(r.stats.status, 0u);
+      EXPECT_EQ(r.stats.nanPixels, 0);
+      for (float v : r.image.rgb) ASSERT_TRUE(std::isfinite(v));
+      EXPECT_GT(r.stats.msCache.progress, 0.0);
+      EXPECT_LT(r.stats.msCache.progress, 1.0);
+    }
+}
+
 // A cache refined within a frame budget (DeviceMsCache::refine with budgetMs > 0), call after call as
 // the viewer refines it, until it holds `paths`: its running means and what the march reads, the
 // calls it took and its build launches.

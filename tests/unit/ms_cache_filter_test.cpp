@@ -199,3 +199,25 @@ TEST(MsCacheFilter, ColumnsWithoutMediumAreSkipped) {
 
 }  // namespace
 }  // namespace narval::test
+
+namespace narval::test {
+namespace {
+
+// A slice of no width (levels a column's march did not reach collapse onto its end) in noiseless
+// nodes, one with a path and the next with none yet (a budgeted build mid-sweep): reading the column
+// over that slice's τ range gives the next slice's value, so the column differs from itself beyond
+// a noise of 0. Its own weight stays 1 all the same, and every filtered value is finite (the
+// distance once put the column's own weight, and every neighbour's, at 0: 0/0).
+TEST(MsCacheFilter, ASliceOfNoWidthBesideANodeOfNoPathsStaysFinite) {
+  const std::function<float(int)> collapsed = [](int s) { return s <= 2 ? 0.5f * float(s) : 1.0f; };
+  FilterCase f = filterCase(3, 3, 4, collapsed, [](int, int, int s) { return s == 2 ? 1.0f : 0.0f; }, 0.0f, 1);
+  for (size_t n = 0; n < f.cache.size(); n += MS_CACHE_STRIDE)
+    if (f.cache[n + MS_VIEW_TAU] == 1.0f && f.cache[n] == 0.0f) f.cache[n + 3] = 0.0f;  // slice 3: no paths yet
+  ASSERT_EQ(collapsed(2), collapsed(3));  // slice 2 spans [1, 1]
+  for (const std::vector<float>& out : {filtered(f, 1.5f, 2.0f), twiced(f, 1.5f, 2.0f)})
+    for (size_t i = 0; i < out.size(); i += MS_CACHE_STRIDE)
+      for (int ch = 0; ch < 3; ++ch) ASSERT_TRUE(std::isfinite(out[i + size_t(ch)])) << "node " << i / MS_CACHE_STRIDE;
+}
+
+}  // namespace
+}  // namespace narval::test
