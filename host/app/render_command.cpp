@@ -257,6 +257,11 @@ int runRender(const RenderArgs& a) {
   const bool realtime = isRealtime(scene.renderer.algorithm);
   const auto [lx, ly] = parseSize(a.localSize, "--local-size");
   refuseFlagsThatDoNotApply(a, scene);
+  if (a.targetMs > 0 && !(scene.renderer.algorithm == Algorithm::Raymarch &&
+                          scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache))
+    std::cerr << "narval: warning: --target-ms: only the ray marcher's multiple-scattering cache is built within a "
+                 "frame budget; this scene's "
+              << algorithmName(scene.renderer.algorithm) << " has none, so every frame is drawn whole\n";
   const int sampleBegin = a.samples.empty() ? 0 : parseSampleRange(a.samples, "--samples").first;
   const OutputPaths out = outputPaths(a);
   const ResumePoint resume = resumePoint(a, scene, out.exr, sampleBegin);

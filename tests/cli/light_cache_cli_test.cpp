@@ -110,6 +110,10 @@ TEST_F(LightCacheCli, ABudgetBuildsTheCacheOverTheFramesToTheSameImage) {
   ASSERT_EQ(run("render s.json -o a.exr" + cache).code, 0);
   expectSameBits((dir_ / "a.exr").string(), (dir_ / "b.exr").string(), {"R", "G", "B"});
 
+  r = run("render s.json -o w.exr --frames 2 --target-ms 50 --algorithm lobe");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.err, "narval: warning: --target-ms: only the ray marcher's multiple-scattering cache is built within "
+                   "a frame budget; this scene's lobe has none, so every frame is drawn whole\n");
   r = run("render s.json -o x.exr --target-ms 50");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "narval: --target-ms requires --frames (see narval --help)\n");
