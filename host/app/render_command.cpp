@@ -85,8 +85,7 @@ void refuseFlagsThatDoNotApply(const RenderArgs& a, const Scene& scene) {
   if (a.targetMs > 0 && !isRealtime(scene.renderer.algorithm))
     throw inputError("--target-ms", "", "only the real-time algorithms render frames in a budget; the algorithm is " +
                                             std::string(algorithmName(scene.renderer.algorithm)));
-  const bool msCache = scene.renderer.algorithm == Algorithm::Raymarch &&
-                       scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache;
+  const bool msCache = scene.renderer.drawsMsCache();
   for (const auto& [flag, value] : {std::pair{"--ms-cache-in", &a.msCacheIn}, {"--ms-cache-out", &a.msCacheOut}})
     if (!value->empty() && !msCache) throw msCacheFlagWithoutCache(flag);
   if (!isRealtime(scene.renderer.algorithm)) return;
@@ -94,9 +93,7 @@ void refuseFlagsThatDoNotApply(const RenderArgs& a, const Scene& scene) {
   const std::string frames = "does not apply to " + algorithm + ", which renders frames (use --frames)";
   if (a.spp >= 0) throw inputError("--spp", "", frames);
   if (!a.samples.empty()) throw inputError("--samples", "", frames);
-  const bool cachePaths = scene.renderer.algorithm == Algorithm::Raymarch &&
-                          scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache;
-  if (a.bounces >= 0 && !cachePaths)
+  if (a.bounces >= 0 && !msCache)
     throw inputError("--bounces", "", "does not apply to " + algorithm +
                                           " (only the ray marcher's multiple-scattering cache traces bounces)");
   if (a.counters)
@@ -257,8 +254,7 @@ int runRender(const RenderArgs& a) {
   const bool realtime = isRealtime(scene.renderer.algorithm);
   const auto [lx, ly] = parseSize(a.localSize, "--local-size");
   refuseFlagsThatDoNotApply(a, scene);
-  if (a.targetMs > 0 && !(scene.renderer.algorithm == Algorithm::Raymarch &&
-                          scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache))
+  if (a.targetMs > 0 && !scene.renderer.drawsMsCache())
     std::cerr << "narval: warning: --target-ms: only the ray marcher's multiple-scattering cache is built within a "
                  "frame budget; this scene's "
               << algorithmName(scene.renderer.algorithm) << " has none, so every frame is drawn whole\n";

@@ -64,6 +64,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
       programOptions_ = dev.buildOptions();
       program_ = buildProgram(rt, "ms_cache.cl", programOptions_);
       kernel_ = NamedKernel(program_, "ms_cache_build");
+      placeKernel_ = NamedKernel(program_, "ms_cache_place_view");
+      filterKernel_ = NamedKernel(program_, "ms_cache_filter_view");
     }
     walkMajorants(rt, dev, pathScene);
     sceneBuf_ = constantBuffer(rt, pathScene);
@@ -79,7 +81,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     ++rebuilds_;
     key_ = key;
     placed_ = view ? 0 : size_t(-1);  // the view nodes' places, first (place())
-    if (restorePending_) restore(rt);
+    if (restore_) restore(rt);
   }
   budgeted_ = budgetMs > 0;
   budgetLeftMs_ = budgetMs;
@@ -111,19 +113,18 @@ MsCacheSnapshot DeviceMsCache::snapshot(ClRuntime& rt) const {
 
 // The pending snapshot into the cache just started (refine's start-over).
 void DeviceMsCache::restore(ClRuntime& rt) {
-  restorePending_ = false;
-  if (restore_.nodes.size() * sizeof(float) != bytes_)
-    throw InputError("the multiple-scattering cache to restore holds " +
-                     std::to_string(restore_.nodes.size() / MS_CACHE_STRIDE) + " nodes; this scene's has " +
-                     std::to_string(bytes_ / (MS_CACHE_STRIDE * sizeof(float))));
-  rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, restore_.nodes.data());
-  paths_ = restore_.paths;
-  sweepPaths_ = restore_.sweepPaths;
-  budgetMin_ = restore_.budgetMin;
-  budgetMax_ = restore_.budgetMax;
-  sweepNode_ = size_t(restore_.sweepNode);
-  placed_ = restore_.placed == UINT64_MAX ? size_t(-1) : size_t(restore_.placed);
-  restore_ = MsCacheSnapshot{};
+  const MsCacheSnapshot s = std::move(*restore_);
+  restore_.reset();
+  if (s.nodes.size() * sizeof(float) != bytes_)
+    throw InputError("the multiple-scattering cache to restore holds " + std::to_string(s.nodes.size() / MS_CACHE_STRIDE) +
+                     " nodes; this scene's has " + std::to_string(bytes_ / (MS_CACHE_STRIDE * sizeof(float))));
+  rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, s.nodes.data());
+  paths_ = s.paths;
+  sweepPaths_ = s.sweepPaths;
+  budgetMin_ = s.budgetMin;
+  budgetMax_ = s.budgetMax;
+  sweepNode_ = size_t(s.sweepNode);
+  placed_ = s.placed == UINT64_MAX ? size_t(-1) : size_t(s.placed);
 }
 
 double DeviceMsCache::pathsDone() const {
@@ -193,7 +194,7 @@ void DeviceMsCache::walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, 
 bool DeviceMsCache::place(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params) {
   const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);
   if (placed_ >= columns) return true;
-  NamedKernel place(program_, "ms_cache_place_view");
+  NamedKernel& place = placeKernel_;
   dev.bind(place);
   place.set("scene", sceneBuf_);
   place.set("grid_majorants", majorantBuf_);
@@ -316,7 +317,7 @@ void DeviceMsCache::filter(ClRuntime& rt, const ms_cache_params& params) {
   for (cl::Buffer* b : {&front_, &back_, &mid_})
     if (!(*b)() && (b != &mid_ || twicingOn_)) *b = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
   if (budgeted_) countActive(rt, params);
-  NamedKernel filter(program_, "ms_cache_filter_view");
+  NamedKernel& filter = filterKernel_;
   filter.set("ms_cache", params);
   filter.set("cache", buffer_);
   const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,7 +44,7 @@ class DeviceMsCache {
   // The next start (the first refine) takes `snapshot` for its nodes and progress instead of zeros: a
   // cache built before, for the same scene and settings (the caller checks them: ms_cache_file.h); the
   // refine goes on from its paths. InputError when its node count is not the start's.
-  void restoreAtStart(MsCacheSnapshot snapshot) { restore_ = std::move(snapshot); restorePending_ = true; }
+  void restoreAtStart(MsCacheSnapshot snapshot) { restore_ = std::move(snapshot); }
   // What the march reads: the running means or, with the view layout's filter (params.filter > 0;
   // kernels/shared/ms_cache_filter.h), their filtered copy, twiced when params.filter_twicing is set.
   // A budgeted refine makes the filtered copy over several calls; until the first is done, the means.
@@ -82,13 +83,12 @@ class DeviceMsCache {
   void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);
 
   std::string key_;
-  MsCacheSnapshot restore_;
-  bool restorePending_ = false;
+  std::optional<MsCacheSnapshot> restore_;  // restoreAtStart's, until the start takes it
   AllocationSite site_;  // what an allocation failure names (the scene file and key)
   cl::Program program_;
   std::string programOptions_;
   size_t placed_ = 0;  // view layout: columns placed so far
-  NamedKernel kernel_;
+  NamedKernel kernel_, placeKernel_, filterKernel_;  // made once per program (a slice a frame sets them)
   cl::Buffer buffer_, sceneBuf_, majorantBuf_, statusBuf_;
   // The filtered copy: front_ is what the march reads once frontReady_; back_ the one being made, mid_
   // twicing's first pass. filterPass_: 0 none under way, 1 the first pass, 2 twicing's second.

@@ -48,7 +48,7 @@ const json& section(ObjectReader& r, const std::string& name) {
 // Sections set for an algorithm that does not read them: named, since nothing would change.
 void warnSectionsThatDoNotApply(const JsonContext& ctx, const ObjectReader& r, const RendererSettings& s) {
   const std::string algorithm = algorithmName(s.algorithm);
-  const bool cache = s.algorithm == Algorithm::Raymarch && s.raymarch.multipleScattering == MultipleScattering::Cache;
+  const bool cache = s.drawsMsCache();
   auto ignored = [&](const char* name, bool applies, const std::string& to) {
     if (!applies && ctx.changedUnder(r.keyOf(name)))
       ctx.warn(r.keyOf(name), "applies to " + to + "; algorithm \"" + algorithm + "\" ignores it");

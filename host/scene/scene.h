@@ -225,6 +225,10 @@ struct RendererSettings {
   RaymarchSettings raymarch;
   LobeSettings lobe;
   LightCacheSettings lightCache;
+  // The ray marcher with its multiple-scattering cache: what traces bounces and builds a cache.
+  bool drawsMsCache() const {
+    return algorithm == Algorithm::Raymarch && raymarch.multipleScattering == MultipleScattering::Cache;
+  }
 };
 
 struct Scene {

@@ -52,8 +52,9 @@ class ViewerSession {
   // The last frame as shown: full resolution (a reduced frame scaled up by pixel replication),
   // display-transformed as the PNG is, with the help overlay when it is on.
   const ImageRGB8& display() const { return display_; }
-  // "narval view: cloud.json | raymarch | 86.7 ms | 320x240 | 1 spp | DEVICE | ms cache 37% | ΔE76 1.09,
-  // JND 15.3%": the ms cache's share built while the ray marcher's multiple-scattering cache refines.
+  // "narval view: SCENE | ALGORITHM | MS ms | WxH | SPP spp | DEVICE | ms cache P% | ΔE76 E, JND J%": the
+  // ms cache part (the share of its paths built) with the ray marcher's multiple-scattering cache, the
+  // error part with --reference at the scene's pose.
   std::string title() const;
   // Frames rendered per resolution ("320x240" → count), in this run.
   const std::map<std::string, int>& framesPerResolution() const { return framesPerResolution_; }
