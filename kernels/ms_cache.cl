@@ -6,6 +6,7 @@
 #include "shared/scene_kinds.h"
 #include "shared/ms_cache_build.h"
 #include "shared/ms_cache_filter.h"
+#include "shared/ms_cache_reproject.h"
 
 __kernel void ms_cache_build(KERNEL_SCENE_ARGS, ms_cache_params ms_cache, uint node_first, uint node_count,
                              uint first, uint count, __global float* cache, __global uint* status_word) {
@@ -45,4 +46,25 @@ __kernel void ms_cache_filter_view(ms_cache_params ms_cache, uint column_first, 
   if (column >= ms_cache.grid.nx * ms_cache.grid.ny) return;
   ms_view_filter_column(&ms_cache.grid, cache, values, residual, column, ms_cache.filter, ms_cache.filter_tolerance,
                         filtered + (size_t)column * MS_CACHE_STRIDE);
+}
+
+/* The view layout's reprojection over a camera move (ms_cache_reproject.h): one work-item per node of
+ * `placed` (placed for `scene`'s camera), read from `previous` (drawn for `previous_camera`) into `prior`. */
+__kernel void ms_cache_reproject_view(__constant scene_params* scene, ms_cache_params ms_cache,
+                                      camera_params previous_camera, __global const float* previous,
+                                      __global const float* placed, __global float* prior) {
+  const int node = (int)get_global_id(0);
+  if (node >= node_grid_count(&ms_cache.grid)) return;
+  ms_view_reproject_node(&scene->camera, &previous_camera, &ms_cache, previous, placed, node,
+                         prior + (size_t)node * MS_CACHE_STRIDE);
+}
+
+/* The drawn cache while the new paths replace the reprojected prior (ms_cache_reproject.h, "Blend"): one
+ * work-item per node; `fresh` the new paths' running means or their filtered copy. */
+__kernel void ms_cache_blend_view(ms_cache_params ms_cache, int target, __global const float* prior,
+                                  __global const float* fresh, __global float* drawn) {
+  const int node = (int)get_global_id(0);
+  if (node >= node_grid_count(&ms_cache.grid)) return;
+  const size_t at = (size_t)node * MS_CACHE_STRIDE;
+  ms_view_blend_node(prior + at, fresh + at, target, drawn + at);
 }

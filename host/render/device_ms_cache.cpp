@@ -27,7 +27,9 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   scene_params pathScene = dev.scene.params;
   if (!towardsCamera) pathScene.camera = camera_params{};
   pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
-  std::string key = rawBytes(pathScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions() +
+  scene_params restScene = pathScene;  // the key less the camera: a move of it alone is told apart
+  restScene.camera = camera_params{};
+  std::string key = rawBytes(restScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions() +
                     (towardsCamera ? "camera" : "uniform") + std::to_string(params.layout) + "/" +
                     std::to_string(params.tile) + (params.direct ? "/direct" : "") + "/guide" +
                     rawBytes(params.guide);
@@ -40,6 +42,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   filterOn_ = view && params.filter > 0;
   twicingOn_ = filterOn_ && params.filter_twicing;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
+  const std::string rest = key;
+  key += rawBytes(pathScene.camera);
   if (key != key_) {
     // Started over with as many nodes as before (a light, the medium or a view cache's camera changed),
     // the old nodes are drawn until each takes its first new path, which replaces all that a lookup
@@ -50,6 +54,20 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     site_ = AllocationSite{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
                                   "x" + std::to_string(c.nz) + " nodes"};
+    // A view cache's camera alone moved in a budgeted refine (a viewer's frame): what was drawn is
+    // reprojected to the new nodes once they are placed, and drawn while their paths come in (blend()).
+    // The running means start from zeros (the blend reads their counts).
+    const bool moved = view && keep && budgetMs > 0 && rest == restKey_ && (paths_ > 0 || priorOn_) && !restore_;
+    if (moved) {
+      if (!previous_()) previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+      rt.queue.enqueueCopyBuffer(buffer(), previous_, 0, 0, bytes_);
+      rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
+      previousCamera_ = camera_;
+      reprojectPending_ = true;
+      frontReady_ = false;
+    }
+    priorOn_ = blended_ = false;
+    if (!moved) prior_ = drawn_ = previous_ = cl::Buffer();
     if (!keep) {
       buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
       rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
@@ -66,6 +84,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
       kernel_ = NamedKernel(program_, "ms_cache_build");
       placeKernel_ = NamedKernel(program_, "ms_cache_place_view");
       filterKernel_ = NamedKernel(program_, "ms_cache_filter_view");
+      reprojectKernel_ = NamedKernel(program_, "ms_cache_reproject_view");
+      blendKernel_ = NamedKernel(program_, "ms_cache_blend_view");
     }
     walkMajorants(rt, dev, pathScene);
     sceneBuf_ = constantBuffer(rt, pathScene);
@@ -80,13 +100,16 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     allocation_ = allocation;
     ++rebuilds_;
     key_ = key;
+    restKey_ = rest;
+    camera_ = pathScene.camera;
     placed_ = view ? 0 : size_t(-1);  // the view nodes' places, first (place())
-    if (restore_) restore(rt);
+    if (restore_) restore(rt, params);
   }
   budgeted_ = budgetMs > 0;
   budgetLeftMs_ = budgetMs;
   if (filterOn_ && filterPass_ > 0) filter(rt, params);  // a filtered copy under way first
   if (!place(rt, dev, params)) return;                   // budget spent before every column is placed
+  if (reprojectPending_) reproject(rt, params);
   int launches = targetPaths;
   if (allocation_.perceptual) {  // the pilot first, then the budgets from it, then the launches they need
     const int pilot = msAllocationPilot(allocation_.meanPaths);
@@ -96,6 +119,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   }
   if (paths_ < launches) addPaths(rt, dev, params, launches, pathsPerLaunch);
   if (filterOn_) filter(rt, params);
+  if (priorOn_) blend(rt, params, targetPaths, paths_ >= launches && !filterPending());
 }
 
 MsCacheSnapshot DeviceMsCache::snapshot(ClRuntime& rt) const {
@@ -108,16 +132,31 @@ MsCacheSnapshot DeviceMsCache::snapshot(ClRuntime& rt) const {
   s.budgetMax = budgetMax_;
   s.sweepNode = sweepNode_;
   s.placed = placed_ == size_t(-1) ? UINT64_MAX : uint64_t(placed_);
+  s.camera = camera_;
   return s;
 }
 
-// The pending snapshot into the cache just started (refine's start-over).
-void DeviceMsCache::restore(ClRuntime& rt) {
+// The pending snapshot into the cache just started (refine's start-over); a view layout's placed for
+// another camera becomes a camera move's prior (filtered first, as it would have been drawn), the
+// paths starting from none.
+void DeviceMsCache::restore(ClRuntime& rt, const ms_cache_params& params) {
   const MsCacheSnapshot s = std::move(*restore_);
   restore_.reset();
   if (s.nodes.size() * sizeof(float) != bytes_)
     throw InputError("the multiple-scattering cache to restore holds " + std::to_string(s.nodes.size() / MS_CACHE_STRIDE) +
                      " nodes; this scene's has " + std::to_string(bytes_ / (MS_CACHE_STRIDE * sizeof(float))));
+  if (params.layout == MS_CACHE_LAYOUT_VIEW && rawBytes(s.camera) != rawBytes(camera_)) {
+    previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+    rt.queue.enqueueWriteBuffer(previous_, CL_TRUE, 0, bytes_, s.nodes.data());
+    if (filterOn_) {
+      const cl::Buffer means = previous_;
+      previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+      filterAll(rt, params, means, previous_);
+    }
+    previousCamera_ = s.camera;
+    reprojectPending_ = true;
+    return;
+  }
   rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, s.nodes.data());
   paths_ = s.paths;
   sweepPaths_ = s.sweepPaths;
@@ -203,7 +242,8 @@ bool DeviceMsCache::place(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms
   place.set("status_word", statusBuf_);
   while (placed_ < columns) {
     if (budgeted_ && budgetLeftMs_ <= 0) return false;
-    const size_t end = budgeted_ ? std::min(columns, placed_ + std::max<size_t>(64, size_t(unitsThatFit(msPerPlace_, 1024, lastPlaced_))))
+    // Budgeted in slices, but all at once under a camera move's prior, which needs every node placed.
+    const size_t end = budgeted_ && !reprojectPending_ ? std::min(columns, placed_ + std::max<size_t>(64, size_t(unitsThatFit(msPerPlace_, 1024, lastPlaced_))))
                                  : columns;
     place.set("column_first", cl_uint(placed_));
     place.set("column_count", cl_uint(end - placed_));
@@ -356,6 +396,69 @@ void DeviceMsCache::filter(ClRuntime& rt, const ms_cache_params& params) {
     filteredKey_ = filteringKey_;
     filteredPaths_ = filteringPaths_;
   }
+}
+
+// The filtered copy of `means` into `out` in one go (the view layout's filter, twiced when it is on).
+void DeviceMsCache::filterAll(ClRuntime& rt, const ms_cache_params& params, const cl::Buffer& means, cl::Buffer& out) {
+  const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);
+  const cl::Buffer first = twicingOn_ ? allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_) : out;
+  NamedKernel& filter = filterKernel_;
+  filter.set("ms_cache", params);
+  filter.set("cache", means);
+  filter.set("column_first", cl_uint(0));
+  filter.set("column_count", cl_uint(columns));
+  for (int pass = 0; pass < (twicingOn_ ? 2 : 1); ++pass) {
+    filter.set("values", pass == 0 ? means : first);
+    filter.set("residual", cl_int(pass));
+    filter.set("filtered", pass == 0 ? first : out);
+    buildMs_ += launchOverNodes(rt, filter.get(), columns, "the multiple-scattering cache", 3 * bytes_);
+  }
+}
+
+// The camera move's prior: the cache drawn before it (previous_) read at the new nodes' points
+// (ms_cache_reproject.h, "Reprojection"), once every column is placed.
+void DeviceMsCache::reproject(ClRuntime& rt, const ms_cache_params& params) {
+  if (!prior_()) prior_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+  NamedKernel& k = reprojectKernel_;
+  k.set("scene", sceneBuf_);
+  k.set("ms_cache", params);
+  k.set("previous_camera", previousCamera_);
+  k.set("previous", previous_);
+  k.set("placed", buffer_);
+  k.set("prior", prior_);
+  const double ms = launchOverNodes(rt, k.get(), nodeGridCount(params.grid), "the multiple-scattering cache", 3 * bytes_);
+  buildMs_ += ms;
+  budgetLeftMs_ -= ms;
+  previous_ = cl::Buffer();
+  reprojectPending_ = false;
+  priorOn_ = true;
+  blended_ = false;
+}
+
+// What is drawn while the new paths come in: the prior alone until the first are (the filtered copy's,
+// with the filter), then blended with them whenever they changed ("Blend"); dropped once `done`.
+void DeviceMsCache::blend(ClRuntime& rt, const ms_cache_params& params, int target, bool done) {
+  if (done) {
+    priorOn_ = blended_ = false;
+    prior_ = drawn_ = cl::Buffer();
+    return;
+  }
+  if (filterOn_ && !frontReady_) return;
+  const std::string key = filterOn_ ? std::to_string(filteredPaths_)
+                                    : std::to_string(paths_) + "/" + std::to_string(sweepNode_);
+  if (blended_ && key == blendedKey_) return;
+  if (!drawn_()) drawn_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+  NamedKernel& k = blendKernel_;
+  k.set("ms_cache", params);
+  k.set("target", cl_int(std::max(1, target)));
+  k.set("prior", prior_);
+  k.set("fresh", filterOn_ ? front_ : buffer_);
+  k.set("drawn", drawn_);
+  const double ms = launchOverNodes(rt, k.get(), nodeGridCount(params.grid), "the multiple-scattering cache", 3 * bytes_);
+  buildMs_ += ms;
+  budgetLeftMs_ -= ms;
+  blended_ = true;
+  blendedKey_ = key;
 }
 
 }  // namespace narval

@@ -22,6 +22,7 @@ struct MsCacheSnapshot {
   std::vector<float> nodes;  // MS_CACHE_STRIDE floats per node (ms_cache.h, "Storage")
   int paths = 0, sweepPaths = 0, budgetMin = 0, budgetMax = 0;
   uint64_t sweepNode = 0, placed = 0;  // the sweep under way; the view layout's columns placed
+  camera_params camera{};  // the view layout's: the camera its nodes are placed and aimed for
 };
 
 class DeviceMsCache {
@@ -43,12 +44,20 @@ class DeviceMsCache {
   MsCacheSnapshot snapshot(ClRuntime& rt) const;
   // The next start (the first refine) takes `snapshot` for its nodes and progress instead of zeros: a
   // cache built before, for the same scene and settings (the caller checks them: ms_cache_file.h); the
-  // refine goes on from its paths. InputError when its node count is not the start's.
+  // refine goes on from its paths. A view layout's built for another camera is the prior of a camera
+  // move instead (below). InputError when its node count is not the start's.
   void restoreAtStart(MsCacheSnapshot snapshot) { restore_ = std::move(snapshot); }
   // What the march reads: the running means or, with the view layout's filter (params.filter > 0;
   // kernels/shared/ms_cache_filter.h), their filtered copy, twiced when params.filter_twicing is set.
   // A budgeted refine makes the filtered copy over several calls; until the first is done, the means.
-  const cl::Buffer& buffer() const { return filterOn_ && frontReady_ ? front_ : buffer_; }
+  // After a view cache's camera moved in a budgeted refine (or was restored from another camera's), the
+  // cache drawn before reprojected to the new nodes, faded out as their new paths come in, and dropped
+  // once they are all in (kernels/shared/ms_cache_reproject.h).
+  const cl::Buffer& buffer() const {
+    if (priorOn_) return blended_ ? drawn_ : prior_;
+    return filterOn_ && frontReady_ ? front_ : buffer_;
+  }
+  bool reprojected() const { return priorOn_; }  // a camera move's prior is drawn
   const cl::Buffer& means() const { return buffer_; }  // the running means, unfiltered
   int paths() const;                               // paths per node so far (allocated: their mean, pro rata)
   // paths() plus the share of the sweep under way (a budgeted refine may stop between its slices).
@@ -70,7 +79,12 @@ class DeviceMsCache {
   // The filtered copy, when the paths or settings changed (budgeted: continued over calls).
   void filter(ClRuntime& rt, const ms_cache_params& params);
   bool place(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params);
-  void restore(ClRuntime& rt);
+  void restore(ClRuntime& rt, const ms_cache_params& params);
+  void filterAll(ClRuntime& rt, const ms_cache_params& params, const cl::Buffer& means, cl::Buffer& out);
+  // A camera move's prior (ms_cache_reproject.h): previous_ into prior_, once the new nodes are placed;
+  // then drawn_, the prior blended with the new paths, until `done`.
+  void reproject(ClRuntime& rt, const ms_cache_params& params);
+  void blend(ClRuntime& rt, const ms_cache_params& params, int target, bool done);
   // Budgeted slices (device_ms_cache.cpp).
   size_t activeBefore(size_t n) const;
   size_t sliceEnd(size_t first, size_t end, double units) const;
@@ -82,13 +96,20 @@ class DeviceMsCache {
   // The majorant grid the paths walk into pathScene and majorantBuf_ (ms_cache.cpp).
   void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);
 
-  std::string key_;
+  std::string key_, restKey_;  // restKey_: key_ less the camera
+  camera_params camera_{};      // the camera the paths see (the view layout's: its nodes are placed for it)
+  // A camera move's prior: previous_, the cache drawn for previousCamera_, until reprojected into prior_;
+  // drawn_ its blend with the new paths (blendedKey_: the paths it was made from).
+  bool reprojectPending_ = false, priorOn_ = false, blended_ = false;
+  camera_params previousCamera_{};
+  cl::Buffer previous_, prior_, drawn_;
+  std::string blendedKey_;
   std::optional<MsCacheSnapshot> restore_;  // restoreAtStart's, until the start takes it
   AllocationSite site_;  // what an allocation failure names (the scene file and key)
   cl::Program program_;
   std::string programOptions_;
   size_t placed_ = 0;  // view layout: columns placed so far
-  NamedKernel kernel_, placeKernel_, filterKernel_;  // made once per program (a slice a frame sets them)
+  NamedKernel kernel_, placeKernel_, filterKernel_, reprojectKernel_, blendKernel_;  // once per program
   cl::Buffer buffer_, sceneBuf_, majorantBuf_, statusBuf_;
   // The filtered copy: front_ is what the march reads once frontReady_; back_ the one being made, mid_
   // twicing's first pass. filterPass_: 0 none under way, 1 the first pass, 2 twicing's second.

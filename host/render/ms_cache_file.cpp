@@ -14,16 +14,42 @@
 namespace narval {
 namespace {
 const char kMagic[] = "narval multiple-scattering cache 1\n";
+
+// The view layout's camera (MsCacheSnapshot::camera), as the floats and sizes of camera_params.
+nlohmann::json cameraJson(const camera_params& c) {
+  const auto v = [](const nv_float4& f) { return nlohmann::json::array({f.x, f.y, f.z}); };
+  return {{"position", v(c.position)}, {"forward", v(c.forward)}, {"right", v(c.right)}, {"up", v(c.up)},
+          {"tan_half_vfov", c.tan_half_vfov}, {"aspect", c.aspect}, {"lens_radius", c.lens_radius},
+          {"focus_distance", c.focus_distance}, {"width", c.width}, {"height", c.height}};
+}
+camera_params cameraFromJson(const nlohmann::json& j) {
+  const auto v = [&](const char* k) {
+    const nlohmann::json& a = j.at(k);
+    return nv_float4{a.at(0).get<float>(), a.at(1).get<float>(), a.at(2).get<float>(), 0.0f};
+  };
+  camera_params c{};
+  c.position = v("position");
+  c.forward = v("forward");
+  c.right = v("right");
+  c.up = v("up");
+  c.tan_half_vfov = j.at("tan_half_vfov").get<float>();
+  c.aspect = j.at("aspect").get<float>();
+  c.lens_radius = j.at("lens_radius").get<float>();
+  c.focus_distance = j.at("focus_distance").get<float>();
+  c.width = j.at("width").get<int>();
+  c.height = j.at("height").get<int>();
+  return c;
+}
 }  // namespace
 
 nlohmann::json msCacheSettings(const Scene& scene) {
   nlohmann::json doc = renderSettings(scene);
   const MsCacheSettings& mc = scene.renderer.raymarch.msCache;
-  const bool towardsCamera = mc.layout == MsCacheLayout::View || mc.closure == MsCacheClosure::Camera;
-  if (!towardsCamera) {
-    doc.erase("camera");
-    if (doc.contains("renderer")) doc["renderer"].erase("resolution");
-  }
+  // The view layout's nodes hold their camera (a file read at another pose is reprojected); the grid
+  // layout's aimed at the camera (closure camera) are for that pose only; the others for any.
+  const bool view = mc.layout == MsCacheLayout::View, towardsCamera = view || mc.closure == MsCacheClosure::Camera;
+  if (view || !towardsCamera) doc.erase("camera");
+  if (!towardsCamera && doc.contains("renderer")) doc["renderer"].erase("resolution");
   const nlohmann::json& raymarch = scene.document.at("renderer").at("raymarch");
   nlohmann::json ms = raymarch.at("msCache");
   // Keys the nodes' running means do not depend on: the paths to go on to, and how a lookup reads
@@ -50,7 +76,8 @@ void writeMsCacheFile(const std::string& path, const MsCacheFile& file) {
                                  {"sweep_paths", s.sweepPaths},
                                  {"sweep_node", s.sweepNode},
                                  {"placed", s.placed},
-                                 {"budget", {s.budgetMin, s.budgetMax}}};
+                                 {"budget", {s.budgetMin, s.budgetMax}},
+                                 {"camera", cameraJson(s.camera)}};
   const std::string head = std::string(kMagic) + header.dump() + "\n";
   AtomicFile out(path);
   if (std::fwrite(head.data(), 1, head.size(), out.file()) != head.size() ||
@@ -81,6 +108,7 @@ MsCacheFile readMsCacheFile(const std::string& path, const std::string& flag, co
     s.placed = h.at("placed").get<uint64_t>();
     s.budgetMin = h.at("budget").at(0).get<int>();
     s.budgetMax = h.at("budget").at(1).get<int>();
+    s.camera = cameraFromJson(h.at("camera"));
   } catch (const nlohmann::json::exception&) {
     throw notACache;
   }

@@ -39,6 +39,20 @@ static inline ray3 camera_ray(NV_CONSTANT const camera_params* c, float px, floa
   return r;
 }
 
+/* Where world point x lies in camera c's image, in pixels ((0, 0) the top-left corner): the inverse of
+ * camera_ray through the lens's centre. 0 when x is not in front of the camera. */
+static inline int camera_project(NV_PRIVATE const camera_params* c, vec3 x, NV_PRIVATE float* px,
+                                 NV_PRIVATE float* py) {
+  const vec3 d = vec3_sub(x, vec3_from4(c->position));
+  const float z = vec3_dot(d, vec3_from4(c->forward));
+  if (!(z > 0.0f)) return 0;
+  const float sx = vec3_dot(d, vec3_from4(c->right)) / (z * c->tan_half_vfov * c->aspect);
+  const float sy = vec3_dot(d, vec3_from4(c->up)) / (z * c->tan_half_vfov);
+  *px = 0.5f * (sx + 1.0f) * (float)c->width;
+  *py = 0.5f * (1.0f - sy) * (float)c->height;
+  return 1;
+}
+
 /* The real-time kernels' ray of pixel (px, py): through its centre, from the lens's centre (they
  * are deterministic: no jitter, no depth of field). */
 static inline ray3 camera_pixel_centre_ray(NV_CONSTANT const camera_params* c, int px, int py) {

@@ -183,12 +183,13 @@ static inline int ms_view_axis(float u, int n, NV_PRIVATE float* w) {
   return node_grid_axis(u, n, w);
 }
 
-static inline ms_view_columns ms_view_locate(NV_PRIVATE const ms_cache_params* mc, int px, int py) {
+/* The columns around image point (x, y) in pixels (clamped to the outermost columns). */
+static inline ms_view_columns ms_view_locate_at(NV_PRIVATE const ms_cache_params* mc, float x, float y) {
   NV_PRIVATE const node_grid_params* c = &mc->grid;
   const float tile = (float)mc->tile;
   float ax, ay;
-  const int x0 = ms_view_axis(((float)px + 0.5f) / tile - 0.5f, c->nx, &ax);
-  const int y0 = ms_view_axis(((float)py + 0.5f) / tile - 0.5f, c->ny, &ay);
+  const int x0 = ms_view_axis(x / tile - 0.5f, c->nx, &ax);
+  const int y0 = ms_view_axis(y / tile - 0.5f, c->ny, &ay);
   ms_view_columns cols;
   for (int k = 0; k < 4; ++k) {
     const int dx = k & 1, dy = k >> 1;
@@ -197,6 +198,11 @@ static inline ms_view_columns ms_view_locate(NV_PRIVATE const ms_cache_params* m
     cols.w[k] = (dx ? ax : 1.0f - ax) * (dy ? ay : 1.0f - ay);
   }
   return cols;
+}
+
+/* Pixel (px, py)'s columns: those around its centre. */
+static inline ms_view_columns ms_view_locate(NV_PRIVATE const ms_cache_params* mc, int px, int py) {
+  return ms_view_locate_at(mc, (float)px + 0.5f, (float)py + 0.5f);
 }
 
 /* 1 − e^{−x} for x ≥ 0, accurate for small x (march_step_weight's series). */

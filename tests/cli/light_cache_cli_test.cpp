@@ -153,9 +153,33 @@ TEST_F(LightCacheCli, ACacheFileBuiltAtOnePoseDrawsAnother) {
   expectSameBits((dir_ / "eight.exr").string(), (dir_ / "more.exr").string(), {"R", "G", "B"});
 }
 
+// A view cache file read at another pose (30° about the look-at point) is the prior of a camera move
+// (kernels/shared/ms_cache_reproject.h): with a budget below any launch its first frame is drawn from
+// the file's nodes reprojected, no new path yet (progress 0), and differs from the same frame without
+// the file (nothing to draw but the first slices); without a budget the build runs to its paths and
+// the image is that of a cache built there from nothing, bit for bit.
+TEST_F(LightCacheCli, AViewCacheFileReadAtAnotherPoseIsDrawnReprojected) {
+  const std::string view = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\" "
+                           "--set renderer.raymarch.msCache.tile=1 --set renderer.raymarch.msCache.paths=8";
+  ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out v.mscache" + view).code, 0);
+  const std::string pose = " --set camera.position=[" + std::to_string(6 * std::sin(3.14159265358979 / 6)) + ",0," +
+                           std::to_string(-6 * std::cos(3.14159265358979 / 6)) + "]";
+  const std::string budget = " --frames 1 --target-ms 0.001";
+  RunResult r = run("render s.json -o prior.exr --stats-json prior.json --ms-cache-in v.mscache" + view + pose + budget);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(stats("prior.json")["ms_cache_progress"], 0.0);
+  EXPECT_EQ(stats("prior.json")["nan_pixels"], 0);
+  ASSERT_EQ(run("render s.json -o empty.exr" + view + pose + budget).code, 0);
+  EXPECT_GT(differingValues((dir_ / "prior.exr").string(), (dir_ / "empty.exr").string(), "R"), 24 * 18 / 4);
+  ASSERT_EQ(run("render s.json -o read.exr --ms-cache-in v.mscache" + view + pose).code, 0);
+  ASSERT_EQ(run("render s.json -o built.exr" + view + pose).code, 0);
+  expectSameBits((dir_ / "built.exr").string(), (dir_ / "read.exr").string(), {"R", "G", "B"});
+}
+
 // A cache file is refused, one line naming the first setting that differs, exit 2, nothing written,
-// for another medium, another light, another cache setting, and (the view layout aiming its paths at
-// the camera) another pose; so are what is not a cache file and the flags where no cache is drawn.
+// for another medium, another light, another cache setting, another pose for the grid layout aimed at
+// the camera (closure camera), and another image size for the view layout (its columns are the
+// image's); so are what is not a cache file and the flags where no cache is drawn.
 TEST_F(LightCacheCli, ACacheFileIsRefusedForAnotherSceneNamingWhatDiffers) {
   const std::string grid = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
                            "--set renderer.raymarch.msCache.paths=2";
@@ -163,6 +187,7 @@ TEST_F(LightCacheCli, ACacheFileIsRefusedForAnotherSceneNamingWhatDiffers) {
                            "--set renderer.raymarch.msCache.paths=2";
   ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out g.mscache" + grid).code, 0);
   ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out v.mscache" + view).code, 0);
+  ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out c.mscache" + grid + " --set renderer.raymarch.msCache.closure=\\\"camera\\\"").code, 0);
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"--ms-cache-in g.mscache" + grid + " --set materials.2.density=5",
        "narval: --ms-cache-in: g.mscache: built for another scene or cache setting (materials[2].density is 6 in "
@@ -173,9 +198,12 @@ TEST_F(LightCacheCli, ACacheFileIsRefusedForAnotherSceneNamingWhatDiffers) {
       {"--ms-cache-in g.mscache" + grid + " --set renderer.raymarch.msCache.resolution=8",
        "narval: --ms-cache-in: g.mscache: built for another scene or cache setting (renderer.raymarch.msCache.resolution "
        "is 4 in g.mscache, 8 in the scene)\n"},
-      {"--ms-cache-in v.mscache" + view + " --set camera.position=[1,0,-6]",
-       "narval: --ms-cache-in: v.mscache: built for another scene or cache setting (camera.position[0] is 0 in "
-       "v.mscache, 1 in the scene)\n"},
+      {"--ms-cache-in c.mscache" + grid + " --set renderer.raymarch.msCache.closure=\\\"camera\\\" --set camera.position=[1,0,-6]",
+       "narval: --ms-cache-in: c.mscache: built for another scene or cache setting (camera.position[0] is 0 in "
+       "c.mscache, 1 in the scene)\n"},
+      {"--ms-cache-in v.mscache" + view + " --resolution 12x9",
+       "narval: --ms-cache-in: v.mscache: built for another scene or cache setting (renderer.resolution[0] is 24 in "
+       "v.mscache, 12 in the scene)\n"},
       {"--ms-cache-in s.json" + grid,
        "narval: --ms-cache-in: s.json: not a multiple-scattering cache (narval render --ms-cache-out writes one)\n"},
       {"--ms-cache-in g.mscache --algorithm lobe",

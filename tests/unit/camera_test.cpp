@@ -200,4 +200,30 @@ TEST(CameraThinLens, RaysMeetAtTheFocusDistance) {
   EXPECT_NEAR(centre.dir.z, pin.dir.z, 1e-6f);
 }
 
+// camera_project is the hand projection above: world points in front of the camera land at the pixel
+// the double-precision projection gives (within 1e-3 pixels in float), and the camera ray through that
+// pixel passes through them; a point behind the camera or in its plane is refused.
+TEST(CameraProject, InvertsTheRayThroughAPixel) {
+  const camera_params c = makeCamera();
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> pixel(-8.0, 72.0), depth(0.5, 30.0);
+  for (int k = 0; k < 200; ++k) {
+    const double px = pixel(gen), py = pixel(gen) * 0.75;
+    const ray3 r = camera_ray(&c, float(px), float(py), 0.5f, 0.5f);
+    const D3 p = add(d3(r.origin), scale(d3(r.dir), depth(gen)));
+    double ex, ey;
+    project(c, p, &ex, &ey);
+    float fx = -1, fy = -1;
+    ASSERT_EQ(camera_project(&c, vec3_make(float(p.x), float(p.y), float(p.z)), &fx, &fy), 1);
+    EXPECT_NEAR(fx, ex, 1e-3);
+    EXPECT_NEAR(fy, ey, 1e-3);
+    EXPECT_NEAR(fx, px, 1e-3);
+    EXPECT_NEAR(fy, py, 1e-3);
+  }
+  const D3 behind = sub(d3(c.position), d3(c.forward)), beside = add(d3(c.position), d3(c.right));
+  float fx, fy;
+  EXPECT_EQ(camera_project(&c, vec3_make(float(behind.x), float(behind.y), float(behind.z)), &fx, &fy), 0);
+  EXPECT_EQ(camera_project(&c, vec3_make(float(beside.x), float(beside.y), float(beside.z)), &fx, &fy), 0);
+}
+
 }  // namespace
