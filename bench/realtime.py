@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
-"""bench/realtime.py frames|tuning|methods [options]: the real-time kernels. frames: with and without
+"""bench/realtime.py frames|tuning|methods|motion [options]: the real-time kernels. frames: with and without
 their light-transmittance cache (frame time, cache build, error against exact marching and a path-traced
 reference); tuning: how the cache's and kernels' automatic settings were chosen; methods: each method at
-each scene's pick, as the README's picture shows them. Details: bench/README.md. Not a test."""
+each scene's pick, as the README's picture shows them; motion: the pick's cache baked at the scene's pose,
+then orbited, K frames within a budget with it (reprojected) and without. Details: bench/README.md."""
 import json
+import math
 import shlex
 import sys
 from pathlib import Path
@@ -17,7 +19,9 @@ DEFAULTS = {"frames": dict(resolutions="320x240 1280x720", frames=7, ref_spp=256
             "methods": dict(resolutions="320x240", frames=3, ref_spp=2048, out="build/realtime_methods",
                             picture="docs/images/realtime_methods.png",
                             scenes="scenes/cloud.json scenes/smoke.json scenes/disney_cloud.json "
-                                   "scenes/disney_cloud_front.json")}
+                                   "scenes/disney_cloud_front.json"),
+            "motion": dict(resolutions="160x120", frames=2, ref_spp=4096, out="build/realtime_motion",
+                           scenes="scenes/cloud.json")}
 p = b.parser(__doc__)
 p.add_argument("experiment", choices=DEFAULTS)
 p.add_argument("--frames", type=int, help="frames per render, the first not timed")
@@ -28,6 +32,9 @@ p.add_argument("--ref-resolutions", help="frames: the resolutions with a referen
 p.add_argument("--refs", help="methods: the references' folder (default OUT/references)")
 p.add_argument("--out", help="frames, methods: where images and references stay")
 p.add_argument("--picture", help="methods: the PNG it draws (default docs/images/realtime_methods.png)")
+p.add_argument("--orbits", default="5 30 90", help="motion: degrees about the vertical through the look-at point")
+p.add_argument("--counts", default="1 20 100", help="motion: frames drawn after the orbit, each count a run")
+p.add_argument("--target-ms", type=float, default=50, help="motion: the frame budget")
 experiment = p.parse_known_args()[0].experiment
 p.set_defaults(**DEFAULTS[experiment])
 if experiment == "methods":  # before any work: it may run this script again under /usr/bin/python3
@@ -186,4 +193,33 @@ def methods():
     b.montage(tiles, a.picture, ["path tracer (reference)"] + [m for m, _ in METHODS])
 
 
-b.main({"frames": frames, "tuning": tuning, "methods": methods}[a.experiment])
+def motion():
+    refs, resolution = Path(a.refs or out / "references"), a.resolutions.split()[0]
+    refs.mkdir(parents=True, exist_ok=True)
+    b.header("scene", "orbit °", "frames", "wall s", "JND76% reprojected", "JND76% without", "JND76% built there",
+             "JND76% reprojected vs built there")
+    for scene in a.scenes.split():
+        name, pick = b.scene_name(scene), CACHE_PICKS[b.scene_name(scene)] + ["--resolution", resolution, "--seed", 1]
+        baked = out / (name + ".mscache")
+        b.render(a, scene, *pick, "--ms-cache-out", baked, out=out / (name + "_baked.exr"))
+        cam = b.resolved_scene(a.narval, scene)["camera"]
+        for degrees in map(float, a.orbits.split()):
+            t, (px, py, pz), (lx, _, lz) = math.radians(degrees), cam["position"], cam["lookAt"]
+            x, z = lx + (px - lx) * math.cos(t) + (pz - lz) * math.sin(t), lz - (px - lx) * math.sin(t) + (pz - lz) * math.cos(t)
+            pose = ["--set", "camera.position=[%r,%r,%r]" % (x, py, z)]
+            ref = refs / ("%s_%s_%g.exr" % (name, resolution, degrees))
+            if not ref.is_file():
+                b.render(a, scene, "--resolution", resolution, "--spp", a.ref_spp, "--seed", 7, *pose, out=ref)
+            there = out / ("%s_%g_built.exr" % (name, degrees))
+            b.render(a, scene, *pick, *pose, out=there)
+            jnd = lambda r, e: "%.2f" % b.compare(a, r, e)["jnd76_pct"]
+            for count in map(int, a.counts.split()):
+                budget = [*pick, *pose, "--frames", count, "--target-ms", a.target_ms]
+                reused, fresh = out / ("%s_%g_%d.exr" % (name, degrees, count)), out / ("%s_%g_%d_none.exr" % (name, degrees, count))
+                s = b.render(a, scene, *budget, "--ms-cache-in", baked, out=reused)
+                b.render(a, scene, *budget, out=fresh)
+                b.row(name, "%g" % degrees, count, "%.2f" % s["seconds"],
+                      jnd(ref, reused), jnd(ref, fresh), jnd(ref, there), jnd(there, reused))
+
+
+b.main({"frames": frames, "tuning": tuning, "methods": methods, "motion": motion}[a.experiment])

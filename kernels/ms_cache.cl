@@ -49,13 +49,15 @@ __kernel void ms_cache_filter_view(ms_cache_params ms_cache, uint column_first, 
 }
 
 /* The view layout's reprojection over a camera move (ms_cache_reproject.h): one work-item per node of
- * `placed` (placed for `scene`'s camera), read from `previous` (drawn for `previous_camera`) into `prior`. */
+ * `placed` (placed for `scene`'s camera), read from `previous` (`previous_cache`, drawn for
+ * `previous_camera`) into `prior`. */
 __kernel void ms_cache_reproject_view(__constant scene_params* scene, ms_cache_params ms_cache,
-                                      camera_params previous_camera, __global const float* previous,
-                                      __global const float* placed, __global float* prior) {
+                                      ms_cache_params previous_cache, camera_params previous_camera,
+                                      __global const float* previous, __global const float* placed,
+                                      __global float* prior) {
   const int node = (int)get_global_id(0);
   if (node >= node_grid_count(&ms_cache.grid)) return;
-  ms_view_reproject_node(&scene->camera, &previous_camera, &ms_cache, previous, placed, node,
+  ms_view_reproject_node(&scene->camera, &previous_camera, &ms_cache, &previous_cache, previous, placed, node,
                          prior + (size_t)node * MS_CACHE_STRIDE);
 }
 

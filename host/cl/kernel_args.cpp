@@ -32,7 +32,7 @@ const std::map<std::string, std::vector<std::string>>& lists() {
       {"ms_cache_build", sceneArgsAnd({"ms_cache", "node_first", "node_count", "first", "count", "cache", "status_word"})},
       {"ms_cache_place_view", sceneArgsAnd({"ms_cache", "column_first", "column_count", "cache", "status_word"})},
       {"ms_cache_filter_view", {"ms_cache", "column_first", "column_count", "cache", "values", "residual", "filtered"}},
-      {"ms_cache_reproject_view", {"scene", "ms_cache", "previous_camera", "previous", "placed", "prior"}},
+      {"ms_cache_reproject_view", {"scene", "ms_cache", "previous_cache", "previous_camera", "previous", "placed", "prior"}},
       {"ms_cache_blend_view", {"ms_cache", "target", "prior", "fresh", "drawn"}},
   };
   return all;

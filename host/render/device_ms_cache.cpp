@@ -27,9 +27,9 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   scene_params pathScene = dev.scene.params;
   if (!towardsCamera) pathScene.camera = camera_params{};
   pathScene.max_bounces = std::max(0, pathScene.max_bounces - 1);  // the march's sample is the first event
-  scene_params restScene = pathScene;  // the key less the camera: a move of it alone is told apart
+  scene_params restScene = pathScene;  // the key less the camera and nodes: a move alone is told apart
   restScene.camera = camera_params{};
-  std::string key = rawBytes(restScene) + rawBytes(dev.scene.grid) + rawBytes(c) + dev.buildOptions() +
+  std::string key = rawBytes(restScene) + rawBytes(dev.scene.grid) + dev.buildOptions() +
                     (towardsCamera ? "camera" : "uniform") + std::to_string(params.layout) + "/" +
                     std::to_string(params.tile) + (params.direct ? "/direct" : "") + "/guide" +
                     rawBytes(params.guide);
@@ -43,31 +43,33 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   twicingOn_ = filterOn_ && params.filter_twicing;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
   const std::string rest = key;
-  key += rawBytes(pathScene.camera);
+  key += rawBytes(c) + rawBytes(pathScene.camera);
   if (key != key_) {
     // Started over with as many nodes as before (a light, the medium or a view cache's camera changed),
     // the old nodes are drawn until each takes its first new path, which replaces all that a lookup
     // reads (the running mean's first step sets it; ms_cache_build.h): the picture is refreshed
     // progressively, not thrown away, and the cache ends as one built from nothing, bit for bit.
     const bool keep = buffer_() && nodes * MS_CACHE_STRIDE * sizeof(float) == bytes_;
-    bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
-    site_ = AllocationSite{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
-                              "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
-                                  "x" + std::to_string(c.nz) + " nodes"};
-    // A view cache's camera alone moved in a budgeted refine (a viewer's frame): what was drawn is
-    // reprojected to the new nodes once they are placed, and drawn while their paths come in (blend()).
-    // The running means start from zeros (the blend reads their counts).
-    const bool moved = view && keep && budgetMs > 0 && rest == restKey_ && (paths_ > 0 || priorOn_) && !restore_;
+    // A view cache's camera or image size alone changed in a budgeted refine (a viewer's frame): what
+    // was drawn is reprojected to the new nodes once they are placed, and drawn while their paths come
+    // in (blend()). The running means start from zeros (the blend reads their counts).
+    const bool moved = view && budgetMs > 0 && rest == restKey_ && (paths_ > 0 || priorOn_) && !restore_;
     if (moved) {
-      if (!previous_()) previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+      previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
       rt.queue.enqueueCopyBuffer(buffer(), previous_, 0, 0, bytes_);
-      rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
       previousCamera_ = camera_;
+      previousParams_ = placedParams_;
       reprojectPending_ = true;
       frontReady_ = false;
     }
     priorOn_ = blended_ = false;
-    if (!moved) prior_ = drawn_ = previous_ = cl::Buffer();
+    prior_ = drawn_ = cl::Buffer();
+    if (!moved) previous_ = cl::Buffer();
+    bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
+    site_ = AllocationSite{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
+                              "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
+                                  "x" + std::to_string(c.nz) + " nodes"};
+    if (moved && keep) rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
     if (!keep) {
       buffer_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
       rt.queue.enqueueFillBuffer(buffer_, cl_float(0), 0, bytes_);
@@ -102,6 +104,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     key_ = key;
     restKey_ = rest;
     camera_ = pathScene.camera;
+    placedParams_ = params;
     placed_ = view ? 0 : size_t(-1);  // the view nodes' places, first (place())
     if (restore_) restore(rt, params);
   }
@@ -154,6 +157,7 @@ void DeviceMsCache::restore(ClRuntime& rt, const ms_cache_params& params) {
       filterAll(rt, params, means, previous_);
     }
     previousCamera_ = s.camera;
+    previousParams_ = params;
     reprojectPending_ = true;
     return;
   }
@@ -422,6 +426,7 @@ void DeviceMsCache::reproject(ClRuntime& rt, const ms_cache_params& params) {
   NamedKernel& k = reprojectKernel_;
   k.set("scene", sceneBuf_);
   k.set("ms_cache", params);
+  k.set("previous_cache", previousParams_);
   k.set("previous_camera", previousCamera_);
   k.set("previous", previous_);
   k.set("placed", buffer_);

@@ -50,9 +50,9 @@ class DeviceMsCache {
   // What the march reads: the running means or, with the view layout's filter (params.filter > 0;
   // kernels/shared/ms_cache_filter.h), their filtered copy, twiced when params.filter_twicing is set.
   // A budgeted refine makes the filtered copy over several calls; until the first is done, the means.
-  // After a view cache's camera moved in a budgeted refine (or was restored from another camera's), the
-  // cache drawn before reprojected to the new nodes, faded out as their new paths come in, and dropped
-  // once they are all in (kernels/shared/ms_cache_reproject.h).
+  // After a view cache's camera or image size changed in a budgeted refine (or it was restored from
+  // another camera's), the cache drawn before reprojected to the new nodes, faded out as their new
+  // paths come in, and dropped once they are all in (kernels/shared/ms_cache_reproject.h).
   const cl::Buffer& buffer() const {
     if (priorOn_) return blended_ ? drawn_ : prior_;
     return filterOn_ && frontReady_ ? front_ : buffer_;
@@ -102,6 +102,7 @@ class DeviceMsCache {
   // drawn_ its blend with the new paths (blendedKey_: the paths it was made from).
   bool reprojectPending_ = false, priorOn_ = false, blended_ = false;
   camera_params previousCamera_{};
+  ms_cache_params placedParams_{}, previousParams_{};  // the start's (its nodes), and previous_'s
   cl::Buffer previous_, prior_, drawn_;
   std::string blendedKey_;
   std::optional<MsCacheSnapshot> restore_;  // restoreAtStart's, until the start takes it

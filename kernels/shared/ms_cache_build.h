@@ -59,10 +59,13 @@ static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int clo
 /* Path k's estimate at node `node` and the direction ω it looked along: the rest's radiance arriving
  * at world point x (a grid node's; a view node's path draws its own in the slice, ms_cache_view.h),
  * plus the next-event estimate with the direct light (ms_cache.h, "Direct"). With the guide ("Guide")
- * ω comes from phase_guide_sample, weighted by phase/mixture density; both MIS weights use the mixture's. */
+ * ω comes from phase_guide_sample, weighted by phase/mixture density; both MIS weights use the mixture's.
+ * *turn: with the camera closure, the estimate's change as w_c turns (ms_cache_reproject.h, "Direction"):
+ * the scattered part's grey value times the score of its direction, d ln p/dμ·(s − μ·w_c), s = −ω,
+ * μ = s·w_c (the direct light's own change is left out); 0 otherwise. */
 static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int node,
                                  NV_GLOBAL const float* v, vec3 x, NV_PRIVATE const uint* keys, uint k,
-                                 NV_PRIVATE vec3* omega) {
+                                 NV_PRIVATE vec3* omega, NV_PRIVATE vec3* turn) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_PRIVATE uint* status = &ctx->status;
   const int view = mc->layout == MS_CACHE_LAYOUT_VIEW, direct = mc->direct;
@@ -88,9 +91,16 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache
   }
   vec3 L = vec3_splat(0.0f);
   if (direct) L = pathtrace_direct_at(KERNEL_CONTEXT_ARG, x, vec3_scale(w_c, -1.0f), u[1], u[4], u[5], gd, &rng);
-  L = vec3_add(L, vec3_scale(pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, direct ? pdf : 0.0f, &rng),
-                             weight));
-  return status_finite_or_zero(status, L);
+  const vec3 scattered =
+      vec3_scale(pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, direct ? pdf : 0.0f, &rng), weight);
+  *turn = vec3_splat(0.0f);
+  if (closure == MS_CACHE_CLOSURE_CAMERA) {
+    const vec3 sc = vec3_scale(*omega, -1.0f);
+    const float mu = vec3_dot(sc, w_c);
+    const float score = phase_log_slope(s->medium.phase, mu) * vec3_average(status_finite_or_zero(status, scattered));
+    *turn = vec3_scale(vec3_sub(sc, vec3_scale(w_c, mu)), score);
+  }
+  return status_finite_or_zero(status, vec3_add(L, scattered));
 }
 
 /* Whether a lookup can read node `node`. Lookups happen only at samples of positive density and read their
@@ -126,25 +136,33 @@ static inline float ms_cache_running_mean(float mean, float x, uint k) {
 }
 
 /* Adds paths [first, first + count) to the running means of node `node` at world point x (ms_cache.h,
- * "Storage": v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch), then ln R and b/R. */
+ * "Storage": v[0..2] R, v[3] the count, v[4 + 4ch .. 6 + 4ch] b of channel ch), then ln R and b/R. The
+ * view layout, which reads neither, holds the mean of the paths' turn in v[4..6] instead
+ * (MS_VIEW_TURN; ms_cache_path). */
 static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, vec3 x,
                                         int node, NV_GLOBAL float* v, uint first, uint count) {
   uint keys[MS_CACHE_LEADING_KEYS];
   ms_cache_leading_keys(ctx->scene->seed, node, keys);
   for (uint k = first; k < first + count; ++k) {
-    vec3 omega;
-    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, mc, node, v, x, keys, k, &omega);
+    vec3 omega, turn;
+    const vec3 L = ms_cache_path(KERNEL_CONTEXT_ARG, mc, node, v, x, keys, k, &omega, &turn);
     const float Lc[3] = {L.x, L.y, L.z};
     const float w[3] = {-3.0f * omega.x, -3.0f * omega.y, -3.0f * omega.z}; /* 3·w, w = −ω */
     const float grey = vec3_average(L);
     v[MS_CACHE_SQUARE] = ms_cache_running_mean(v[MS_CACHE_SQUARE], grey * grey, k);
     for (int ch = 0; ch < 3; ++ch) {
       v[ch] = ms_cache_running_mean(v[ch], Lc[ch], k);
+      if (mc->layout == MS_CACHE_LAYOUT_VIEW) continue;
       for (int a = 0; a < 3; ++a) v[4 + 4 * ch + a] = ms_cache_running_mean(v[4 + 4 * ch + a], Lc[ch] * w[a], k);
+    }
+    if (mc->layout == MS_CACHE_LAYOUT_VIEW) {
+      const float t[3] = {turn.x, turn.y, turn.z};
+      for (int a = 0; a < 3; ++a) v[MS_VIEW_TURN + a] = ms_cache_running_mean(v[MS_VIEW_TURN + a], t[a], k);
     }
     v[3] = (float)(k + 1u);
   }
-  /* What the lookup reads (ms_cache.h, "Storage"). */
+  /* What the grid layout's lookup reads (ms_cache.h, "Storage"). */
+  if (mc->layout == MS_CACHE_LAYOUT_VIEW) return;
   for (int ch = 0; ch < 3; ++ch) {
     const float R = v[ch];
     v[MS_CACHE_LOG_R + ch] = R > 0.0f ? nv_log(R) : -NV_INFINITY;

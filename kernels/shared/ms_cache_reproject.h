@@ -13,10 +13,17 @@
  * read (the first slice before the medium, the last past it), bilinearly, columns without medium
  * dropping out as in a lookup. The old nodes' path counts, mixed the same way, say what the value is
  * worth; a point outside the old image or behind its camera reads the nearest columns' value worth no
- * paths (the new paths replace it at once). The value is the in-scattering towards the old camera: exact
- * for an isotropic phase function (direct light included), off by the phase function's change over the
- * angle between the two cameras otherwise, and blurred by the old slices' width along the new rays.
- * The same camera gives back every node exactly.
+ * paths (the new paths replace it at once). The value is blurred by the old slices' width along the
+ * new rays; the same camera gives back every node exactly.
+ *
+ * Direction: an old node holds the in-scattering towards the old camera, J(w_old), and the new pose
+ * wants J(w_new), w the direction from the point to the camera. For an isotropic phase function they
+ * are equal; for a peaked one (clouds' g 0.8: a lobe about 10° wide) they differ already at a few
+ * degrees (bench/RESULTS.md). Each node also holds ∇J (MS_VIEW_TURN), estimated from its own paths by
+ * the score of their directions: J(w) = E[L·p(s·w)/q(s)] over directions s drawn with density q, so
+ * ∇_w J = E[L·(p(s·w)/q(s))·(d ln p/dμ)·(s − μw)] (the likelihood-ratio estimator; the direct light's
+ * own change is left out). The value read is J·(1 + ∇J·(w_new − w_old)/J), the first-order change,
+ * its factor kept within [1/2, 2] (the expansion is for small turns; the blend fades what it misses).
  *
  * Blend (ms_view_blend_node): with n new paths at a node (its budget or `target` of them to come), its
  * prior of m paths counts m·(1 − n/N): the drawn value is the weighted mean, the prior's share falls
@@ -35,13 +42,16 @@ static inline float ms_view_node_depth(NV_GLOBAL const float* v) {
   return v[MS_VIEW_T] + f * (v[MS_VIEW_T_END] - v[MS_VIEW_T]);
 }
 
-/* Node `node` of `placed` (the cache just placed for camera `cam`) into `out` (its node), its values and
- * count read from `previous`, the cache drawn for camera `old` in the same layout ("Reprojection"). */
+/* Node `node` of `placed` (the cache `mc` just placed for camera `cam`) into `out` (its node), its values
+ * and count read from `previous`, the cache `old_mc` drawn for camera `old` (a view layout of any size:
+ * the viewer draws smaller frames while the camera moves) ("Reprojection"). */
 static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, NV_PRIVATE const camera_params* old,
-                                          NV_PRIVATE const ms_cache_params* mc, NV_GLOBAL const float* previous,
-                                          NV_GLOBAL const float* placed, int node, NV_GLOBAL float* out) {
+                                          NV_PRIVATE const ms_cache_params* mc, NV_PRIVATE const ms_cache_params* old_mc,
+                                          NV_GLOBAL const float* previous, NV_GLOBAL const float* placed, int node,
+                                          NV_GLOBAL float* out) {
   NV_PRIVATE const node_grid_params* c = &mc->grid;
-  const size_t slice_stride = (size_t)c->nx * (size_t)c->ny * MS_CACHE_STRIDE;
+  NV_PRIVATE const node_grid_params* oc = &old_mc->grid;
+  const size_t slice_stride = (size_t)oc->nx * (size_t)oc->ny * MS_CACHE_STRIDE;
   NV_GLOBAL const float* v = placed + (size_t)node * MS_CACHE_STRIDE;
   for (int i = 0; i < MS_CACHE_STRIDE; ++i) out[i] = v[i];
   for (int i = 0; i < 4; ++i) out[i] = 0.0f;
@@ -52,16 +62,21 @@ static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, 
   if (!camera_project(old, x, &px, &py)) return;
   const int inside = px >= 0.0f && py >= 0.0f && px <= (float)old->width && py <= (float)old->height;
   const float t = vec3_length(vec3_sub(x, vec3_from4(old->position)));
-  const ms_view_columns cols = ms_view_locate_at(mc, px, py);
+  const ms_view_columns cols = ms_view_locate_at(old_mc, px, py);
+  const vec3 turn = vec3_sub(vec3_normalize(vec3_sub(vec3_from4(cam->position), x)),
+                             vec3_normalize(vec3_sub(vec3_from4(old->position), x)));
   vec3 sum = vec3_splat(0.0f);
   float count = 0.0f, weight = 0.0f;
   for (int k = 0; k < 4; ++k) {
     NV_GLOBAL const float* col = previous + (size_t)cols.column[k] * MS_CACHE_STRIDE;
     if (!(cols.w[k] > 0.0f) || col[MS_VIEW_TAU] < 0.0f) continue;
     int s = 0;
-    while (s + 1 < c->nz && col[(size_t)(s + 1) * slice_stride + MS_VIEW_T] <= t) ++s;
+    while (s + 1 < oc->nz && col[(size_t)(s + 1) * slice_stride + MS_VIEW_T] <= t) ++s;
     NV_GLOBAL const float* o = col + (size_t)s * slice_stride;
-    sum = vec3_add(sum, vec3_scale(vec3_make(o[0], o[1], o[2]), cols.w[k]));
+    const vec3 J = vec3_make(o[0], o[1], o[2]);
+    const float grey = vec3_average(J);
+    const float change = grey > 0.0f ? vec3_dot(vec3_make(o[MS_VIEW_TURN], o[MS_VIEW_TURN + 1], o[MS_VIEW_TURN + 2]), turn) / grey : 0.0f;
+    sum = vec3_add(sum, vec3_scale(J, cols.w[k] * nv_fmin(2.0f, nv_fmax(0.5f, 1.0f + change))));
     count += cols.w[k] * o[3];
     weight += cols.w[k];
   }

@@ -50,6 +50,9 @@
 /* BUDGET: the paths a node takes (ms_cache_build.h; 0: as each launch asks), from the host's perceptual
  * allocation (render/ms_cache_allocation.h). SEEN, on slice 0: the background's light through the
  * column's last level, T_end·grey(L_b), which that allocation weighs by. */
+/* TURN (3 floats): the mean of the paths' turn, the node's grey value's gradient as the direction to the
+ * camera turns (ms_cache_build.h, ms_cache_path; ms_cache_reproject.h). */
+#define MS_VIEW_TURN 4
 #define MS_VIEW_BUDGET 7
 #define MS_VIEW_SEEN 15
 #define MS_VIEW_T_MIN 0.01f

@@ -56,6 +56,13 @@ static inline float phase_eval_mu(phase_params p, float mu) {
   }
 }
 
+/* d ln p / dμ by central differences (one-sided at μ = ±1), for any kind: the score of a direction drawn
+ * from p about an axis, as the axis turns (ms_cache_reproject.h, "Direction"). */
+static inline float phase_log_slope(phase_params p, float mu) {
+  const float h = 1e-3f, lo = nv_fmax(-1.0f, mu - h), hi = nv_fmin(1.0f, mu + h), here = phase_eval_mu(p, mu);
+  return here > 0.0f ? (phase_eval_mu(p, hi) - phase_eval_mu(p, lo)) / ((hi - lo) * here) : 0.0f;
+}
+
 /* μ drawn from p with one uniform number u. */
 static inline float phase_sample_mu(phase_params p, float u) {
   switch (PHASE_KIND(p.kind)) {
