@@ -32,9 +32,7 @@ p.add_argument("--ref-resolutions", help="frames: the resolutions with a referen
 p.add_argument("--refs", help="methods: the references' folder (default OUT/references)")
 p.add_argument("--out", help="frames, methods: where images and references stay")
 p.add_argument("--picture", help="methods: the PNG it draws (default docs/images/realtime_methods.png)")
-p.add_argument("--orbits", default="5 30 90", help="motion: degrees about the vertical through the look-at point")
-p.add_argument("--counts", default="1 20 100", help="motion: frames drawn after the orbit, each count a run")
-p.add_argument("--target-ms", type=float, default=50, help="motion: the frame budget")
+b.options(p, orbits="5 30 90", counts="1 20 100", target_ms=50.0)  # motion: bench/README.md
 experiment = p.parse_known_args()[0].experiment
 p.set_defaults(**DEFAULTS[experiment])
 if experiment == "methods":  # before any work: it may run this script again under /usr/bin/python3
@@ -194,32 +192,31 @@ def methods():
 
 
 def motion():
-    refs, resolution = Path(a.refs or out / "references"), a.resolutions.split()[0]
+    refs, res = Path(a.refs or out / "references"), a.resolutions.split()[0]
     refs.mkdir(parents=True, exist_ok=True)
     b.header("scene", "orbit °", "frames", "wall s", "JND76% reprojected", "JND76% without", "JND76% built there",
              "JND76% reprojected vs built there")
+    jnd = lambda ref, test: "%.2f" % b.compare(a, ref, test)["jnd76_pct"]  # noqa: E731
     for scene in a.scenes.split():
-        name, pick = b.scene_name(scene), CACHE_PICKS[b.scene_name(scene)] + ["--resolution", resolution, "--seed", 1]
-        baked = out / (name + ".mscache")
-        b.render(a, scene, *pick, "--ms-cache-out", baked, out=out / (name + "_baked.exr"))
-        cam = b.resolved_scene(a.narval, scene)["camera"]
+        name, cam = b.scene_name(scene), b.resolved_scene(a.narval, scene)["camera"]
+        pick, baked = CACHE_PICKS[name] + ["--resolution", res, "--seed", 1], out / (name + ".mscache")
+        b.render(a, scene, *pick, "--ms-cache-out", baked)
         for degrees in map(float, a.orbits.split()):
             t, (px, py, pz), (lx, _, lz) = math.radians(degrees), cam["position"], cam["lookAt"]
-            x, z = lx + (px - lx) * math.cos(t) + (pz - lz) * math.sin(t), lz - (px - lx) * math.sin(t) + (pz - lz) * math.cos(t)
-            pose = ["--set", "camera.position=[%r,%r,%r]" % (x, py, z)]
-            ref = refs / ("%s_%s_%g.exr" % (name, resolution, degrees))
+            x, z = (lx + (px - lx) * math.cos(t) + (pz - lz) * math.sin(t),
+                    lz - (px - lx) * math.sin(t) + (pz - lz) * math.cos(t))
+            pose, stem = ["--set", "camera.position=[%r,%r,%r]" % (x, py, z)], out / ("%s_%g" % (name, degrees))
+            ref, there = refs / ("%s_%s_%g.exr" % (name, res, degrees)), stem.with_suffix(".built.exr")
             if not ref.is_file():
-                b.render(a, scene, "--resolution", resolution, "--spp", a.ref_spp, "--seed", 7, *pose, out=ref)
-            there = out / ("%s_%g_built.exr" % (name, degrees))
+                b.render(a, scene, "--resolution", res, "--spp", a.ref_spp, "--seed", 7, *pose, out=ref)
             b.render(a, scene, *pick, *pose, out=there)
-            jnd = lambda r, e: "%.2f" % b.compare(a, r, e)["jnd76_pct"]
             for count in map(int, a.counts.split()):
-                budget = [*pick, *pose, "--frames", count, "--target-ms", a.target_ms]
-                reused, fresh = out / ("%s_%g_%d.exr" % (name, degrees, count)), out / ("%s_%g_%d_none.exr" % (name, degrees, count))
-                s = b.render(a, scene, *budget, "--ms-cache-in", baked, out=reused)
-                b.render(a, scene, *budget, out=fresh)
-                b.row(name, "%g" % degrees, count, "%.2f" % s["seconds"],
-                      jnd(ref, reused), jnd(ref, fresh), jnd(ref, there), jnd(there, reused))
+                runs = [(stem.with_suffix(".%d%s.exr" % (count, more and "reused")), more)
+                        for more in (["--ms-cache-in", baked], [])]
+                s = [b.render(a, scene, *pick, *pose, "--frames", count, "--target-ms", a.target_ms, *more, out=exr)
+                     for exr, more in runs][0]
+                b.row(name, "%g" % degrees, count, "%.2f" % s["seconds"], jnd(ref, runs[0][0]), jnd(ref, runs[1][0]),
+                      jnd(ref, there), jnd(there, runs[0][0]))
 
 
 b.main({"frames": frames, "tuning": tuning, "methods": methods, "motion": motion}[a.experiment])

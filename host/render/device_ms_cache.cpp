@@ -45,8 +45,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   const std::string rest = key;
   key += rawBytes(c) + rawBytes(pathScene.camera);
   if (key != key_) {
-    // Started over with as many nodes as before (a light, the medium or a view cache's camera changed),
-    // the old nodes are drawn until each takes its first new path, which replaces all that a lookup
+    // Started over with as many nodes as before (a light or the medium changed; a view cache's camera
+    // without a budget), the old nodes are drawn until each takes its first new path, which replaces all that a lookup
     // reads (the running mean's first step sets it; ms_cache_build.h): the picture is refreshed
     // progressively, not thrown away, and the cache ends as one built from nothing, bit for bit.
     const bool keep = buffer_() && nodes * MS_CACHE_STRIDE * sizeof(float) == bytes_;

@@ -23,7 +23,10 @@
  * the score of their directions: J(w) = E[L·p(s·w)/q(s)] over directions s drawn with density q, so
  * ∇_w J = E[L·(p(s·w)/q(s))·(d ln p/dμ)·(s − μw)] (the likelihood-ratio estimator; the direct light's
  * own change is left out). The value read is J·(1 + ∇J·(w_new − w_old)/J), the first-order change,
- * its factor kept within [1/2, 2] (the expansion is for small turns; the blend fades what it misses).
+ * its factor kept within [1/2, 2]. The expansion holds for turns small against the phase function's
+ * width w (phase_width; 1 − |g| rad for HG), so the paths the value is worth shrink with the turn θ
+ * as e^{−(c/w)²}, c = |w_new − w_old| = 2·sin(θ/2): a few degrees keep most of them in a cloud, 30°
+ * almost none, and the new paths replace it at once (bench/RESULTS.md).
  *
  * Blend (ms_view_blend_node): with n new paths at a node (its budget or `target` of them to come), its
  * prior of m paths counts m·(1 − n/N): the drawn value is the weighted mean, the prior's share falls
@@ -42,10 +45,11 @@ static inline float ms_view_node_depth(NV_GLOBAL const float* v) {
   return v[MS_VIEW_T] + f * (v[MS_VIEW_T_END] - v[MS_VIEW_T]);
 }
 
-/* Node `node` of `placed` (the cache `mc` just placed for camera `cam`) into `out` (its node), its values
+/* Node `node` of `placed` (the cache `mc` just placed for camera `cam`; the medium's `phase`) into `out`, its values
  * and count read from `previous`, the cache `old_mc` drawn for camera `old` (a view layout of any size:
  * the viewer draws smaller frames while the camera moves) ("Reprojection"). */
-static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, NV_PRIVATE const camera_params* old,
+static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, phase_params phase,
+                                          NV_PRIVATE const camera_params* old,
                                           NV_PRIVATE const ms_cache_params* mc, NV_PRIVATE const ms_cache_params* old_mc,
                                           NV_GLOBAL const float* previous, NV_GLOBAL const float* placed, int node,
                                           NV_GLOBAL float* out) {
@@ -65,6 +69,7 @@ static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, 
   const ms_view_columns cols = ms_view_locate_at(old_mc, px, py);
   const vec3 turn = vec3_sub(vec3_normalize(vec3_sub(vec3_from4(cam->position), x)),
                              vec3_normalize(vec3_sub(vec3_from4(old->position), x)));
+  const float theta = vec3_length(turn) / phase_width(phase); /* the chord, 2·sin(θ/2), in widths */
   vec3 sum = vec3_splat(0.0f);
   float count = 0.0f, weight = 0.0f;
   for (int k = 0; k < 4; ++k) {
@@ -84,7 +89,7 @@ static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, 
   out[0] = sum.x / weight;
   out[1] = sum.y / weight;
   out[2] = sum.z / weight;
-  out[3] = inside ? count / weight : 0.0f;
+  out[3] = inside ? count / weight * nv_exp(-theta * theta) : 0.0f;
 }
 
 /* Node `fresh` (the new paths' running means, or their filtered copy) drawn with its reprojected

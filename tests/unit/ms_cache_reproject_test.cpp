@@ -60,7 +60,7 @@ std::vector<float> reproject(const camera_params& now, const camera_params& old,
   const ms_cache_params mc = viewParams();
   std::vector<float> prior(placed.size(), -1.0f);
   for (int node = 0; node < node_grid_count(&mc.grid); ++node)
-    ms_view_reproject_node(&now, &old, &mc, &mc, previous.data(), placed.data(), node,
+    ms_view_reproject_node(&now, phase_make(PHASE_ISOTROPIC, 0.0f), &old, &mc, &mc, previous.data(), placed.data(), node,
                            prior.data() + size_t(node) * MS_CACHE_STRIDE);
   return prior;
 }
