@@ -23,10 +23,15 @@
  * the score of their directions: J(w) = E[L·p(s·w)/q(s)] over directions s drawn with density q, so
  * ∇_w J = E[L·(p(s·w)/q(s))·(d ln p/dμ)·(s − μw)] (the likelihood-ratio estimator; the direct light's
  * own change is left out). The value read is J·(1 + ∇J·(w_new − w_old)/J), the first-order change,
- * its factor kept within [1/2, 2]. The expansion holds for turns small against the phase function's
- * width w (phase_width; 1 − |g| rad for HG), so the paths the value is worth shrink with the turn θ
- * as e^{−(c/w)²}, c = |w_new − w_old| = 2·sin(θ/2): a few degrees keep most of them in a cloud, 30°
- * almost none, and the new paths replace it at once (bench/RESULTS.md).
+ * its factor kept within [1/2, 2].
+ *
+ * Worth: what is left is second order, a relative bias of about x² for a turn of x = c/w phase widths
+ * (c = |w_new − w_old| = 2·sin(θ/2), w = phase_width: 1 − |g| rad for HG). The mean of n new paths
+ * has a relative variance v/n, v = (mean of L² − J²)/J² a path (the old node's, from its paths), so
+ * the prior is worth as many paths as make that equal its bias squared, n = v/x⁴, and never more than
+ * the old node held. A few degrees keep the old paths in a cloud; a turn of several widths leaves a
+ * fraction of a path, so the first new paths replace it; a thin medium, whose paths are less noisy,
+ * trusts its prior less at the same turn (bench/RESULTS.md).
  *
  * Blend (ms_view_blend_node): with n new paths at a node (its budget or `target` of them to come), its
  * prior of m paths counts m·(1 − n/N): the drawn value is the weighted mean, the prior's share falls
@@ -69,7 +74,7 @@ static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, 
   const ms_view_columns cols = ms_view_locate_at(old_mc, px, py);
   const vec3 turn = vec3_sub(vec3_normalize(vec3_sub(vec3_from4(cam->position), x)),
                              vec3_normalize(vec3_sub(vec3_from4(old->position), x)));
-  const float theta = vec3_length(turn) / phase_width(phase); /* the chord, 2·sin(θ/2), in widths */
+  const float widths = vec3_length(turn) / phase_width(phase), x4 = widths * widths * widths * widths; /* ("Worth") */
   vec3 sum = vec3_splat(0.0f);
   float count = 0.0f, weight = 0.0f;
   for (int k = 0; k < 4; ++k) {
@@ -82,14 +87,15 @@ static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, 
     const float grey = vec3_average(J);
     const float change = grey > 0.0f ? vec3_dot(vec3_make(o[MS_VIEW_TURN], o[MS_VIEW_TURN + 1], o[MS_VIEW_TURN + 2]), turn) / grey : 0.0f;
     sum = vec3_add(sum, vec3_scale(J, cols.w[k] * nv_fmin(2.0f, nv_fmax(0.5f, 1.0f + change))));
-    count += cols.w[k] * o[3];
+    const float v = grey > 0.0f ? nv_fmax(0.0f, o[MS_CACHE_SQUARE] - grey * grey) / (grey * grey) : 0.0f;
+    count += cols.w[k] * (v < o[3] * x4 ? v / x4 : o[3]);
     weight += cols.w[k];
   }
   if (!(weight > 0.0f)) return;
   out[0] = sum.x / weight;
   out[1] = sum.y / weight;
   out[2] = sum.z / weight;
-  out[3] = inside ? count / weight * nv_exp(-theta * theta) : 0.0f;
+  out[3] = inside ? count / weight : 0.0f;
 }
 
 /* Node `fresh` (the new paths' running means, or their filtered copy) drawn with its reprojected

@@ -125,6 +125,12 @@ TEST_F(ViewCli, MovingFramesAreSmallerAndCountedPerResolution) {
           "env -u DISPLAY -u WAYLAND_DISPLAY");
   ASSERT_EQ(v.code, 0) << v.err;
   EXPECT_EQ(stats("large.json")["frames_per_resolution"], nlohmann::json({{"64x48", 9}}));
+  // Per resolution, the median frame and the largest after the first (the first builds the programs):
+  // no smaller than the median (four frames: the median is at most the second largest).
+  const nlohmann::json small = stats("small.json")["per_resolution"];
+  EXPECT_GE(small["64x48"]["frame_ms_max_after_first"].get<double>(), small["64x48"]["frame_ms_median"].get<double>());
+  EXPECT_GT(small["8x6"]["frame_ms_max_after_first"].get<double>(), 0.0);
+  EXPECT_EQ(stats("large.json")["per_resolution"]["64x48"]["frames"], 9);
 }
 
 TEST_F(ViewCli, LiveErrorAgainstTheReferenceAtItsPoseOnly) {

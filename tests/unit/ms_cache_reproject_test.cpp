@@ -37,7 +37,7 @@ ms_cache_params viewParams() {
 }
 
 // Every column's slices at optical depths {0, 0.5, 1.2, 2.5, 4} and distances t0 + {0, 0.5, 1.3, 2.5, 4};
-// node (column, s) holds 10·column + s (grey) from 20 + s paths.
+// node (column, s) holds 10·column + s (grey) from 20 + s paths of relative variance 1.
 std::vector<float> placedCache(const ms_cache_params& mc, float t0) {
   const float tau[5] = {0.0f, 0.5f, 1.2f, 2.5f, 4.0f}, t[5] = {0.0f, 0.5f, 1.3f, 2.5f, 4.0f};
   const int columns = mc.grid.nx * mc.grid.ny;
@@ -47,6 +47,7 @@ std::vector<float> placedCache(const ms_cache_params& mc, float t0) {
       float* v = cache.data() + size_t(col + columns * s) * MS_CACHE_STRIDE;
       v[0] = v[1] = v[2] = float(10 * col + s);
       v[3] = float(20 + s);
+      v[MS_CACHE_SQUARE] = 2.0f * v[0] * v[0];  // a path's relative variance 1 (ms_cache_reproject.h, "Worth")
       v[MS_VIEW_TAU] = tau[s];
       v[MS_VIEW_TAU_END] = tau[s + 1];
       v[MS_VIEW_T] = t0 + t[s];
