@@ -54,8 +54,9 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     // was drawn is reprojected to the new nodes once they are placed, and drawn while their paths come
     // in (blend()). The running means start from zeros (the blend reads their counts).
     const bool moved = view && budgetMs > 0 && rest == restKey_ && (paths_ > 0 || priorOn_) && !restore_;
-    if (moved) {
-      previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+    if (moved) {  // the buffers of one move kept for the next (a viewer moves frame after frame)
+      if (previousBytes_ != bytes_) previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+      previousBytes_ = bytes_;
       rt.queue.enqueueCopyBuffer(buffer(), previous_, 0, 0, bytes_);
       previousCamera_ = camera_;
       previousParams_ = placedParams_;
@@ -63,8 +64,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
       frontReady_ = false;
     }
     priorOn_ = blended_ = false;
-    prior_ = drawn_ = cl::Buffer();
-    if (!moved) previous_ = cl::Buffer();
+    if (!keep || !moved) prior_ = drawn_ = cl::Buffer();
+    if (!moved) previous_ = cl::Buffer(), previousBytes_ = 0;
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
     site_ = AllocationSite{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
@@ -150,6 +151,7 @@ void DeviceMsCache::restore(ClRuntime& rt, const ms_cache_params& params) {
                      " nodes; this scene's has " + std::to_string(bytes_ / (MS_CACHE_STRIDE * sizeof(float))));
   if (params.layout == MS_CACHE_LAYOUT_VIEW && rawBytes(s.camera) != rawBytes(camera_)) {
     previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
+    previousBytes_ = bytes_;
     rt.queue.enqueueWriteBuffer(previous_, CL_TRUE, 0, bytes_, s.nodes.data());
     if (filterOn_) {
       const cl::Buffer means = previous_;
@@ -434,7 +436,6 @@ void DeviceMsCache::reproject(ClRuntime& rt, const ms_cache_params& params) {
   const double ms = launchOverNodes(rt, k.get(), nodeGridCount(params.grid), "the multiple-scattering cache", 3 * bytes_);
   buildMs_ += ms;
   budgetLeftMs_ -= ms;
-  previous_ = cl::Buffer();
   reprojectPending_ = false;
   priorOn_ = true;
   blended_ = false;
@@ -443,9 +444,10 @@ void DeviceMsCache::reproject(ClRuntime& rt, const ms_cache_params& params) {
 // What is drawn while the new paths come in: the prior alone until the first are (the filtered copy's,
 // with the filter), then blended with them whenever they changed ("Blend"); dropped once `done`.
 void DeviceMsCache::blend(ClRuntime& rt, const ms_cache_params& params, int target, bool done) {
-  if (done) {
+  if (done) {  // the buffers go with the prior (the cache is whole: a viewer has stopped moving)
     priorOn_ = blended_ = false;
-    prior_ = drawn_ = cl::Buffer();
+    prior_ = drawn_ = previous_ = cl::Buffer();
+    previousBytes_ = 0;
     return;
   }
   if (filterOn_ && !frontReady_) return;

@@ -104,6 +104,7 @@ class DeviceMsCache {
   camera_params previousCamera_{};
   ms_cache_params placedParams_{}, previousParams_{};  // the start's (its nodes), and previous_'s
   cl::Buffer previous_, prior_, drawn_;
+  size_t previousBytes_ = 0;  // previous_'s size
   std::string blendedKey_;
   std::optional<MsCacheSnapshot> restore_;  // restoreAtStart's, until the start takes it
   AllocationSite site_;  // what an allocation failure names (the scene file and key)

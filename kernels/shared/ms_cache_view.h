@@ -115,24 +115,32 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
   vec3 Lb;
   if (!march_view(s, ctx->lights, r.origin, r.dir, &Lb, &seg)) return;
   const float sigma = ms_view_sigma_t(&s->medium);
-  /* First march: τ_end, the column over the same samples as the second (the segment [t0, t1] again). */
-  const float total = sigma * march_column_density(KERNEL_CONTEXT_ARG, r.origin, r.dir, seg.t1, MS_VIEW_PLACE_STEPS);
+  /* One march over the segment, its samples' densities kept: τ_end first (march_column_density's sum,
+   * bit for bit), then where τ(t), linear over each step, reaches each level in turn; levels it does not
+   * reach (rounding, or past τ_max) lie at the end of the last step with medium. */
+  float rho[MS_VIEW_PLACE_STEPS], at[MS_VIEW_PLACE_STEPS], sum = 0.0f, t;
+  int samples = 0;
+  march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_PLACE_STEPS);
+  while (samples < MS_VIEW_PLACE_STEPS && march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
+    at[samples] = t;
+    rho[samples] = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg.o, seg.d, t));
+    sum += rho[samples++];
+  }
+  ctx->status |= it.status;
+  const float total = sigma * (sum * it.delta);
   if (!(total > 0.0f)) return;
   const float t_end = nv_fmax(nv_exp(-total), MS_VIEW_T_MIN);
   cache[MS_VIEW_SEEN] = t_end * vec3_average(Lb);
-  /* Second march: where τ(t), linear over each step, reaches each level in turn; levels it does not
-   * reach (rounding, or past τ_max) lie at the end of the last step with medium. */
   int i = 0;
-  float acc = 0.0f, end = seg.t0, t;
-  march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_PLACE_STEPS);
-  while (i <= c->nz && march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
-    const float d = ms_view_step_depth(KERNEL_CONTEXT_ARG, &seg, sigma, t, it.delta);
+  float acc = 0.0f, end = seg.t0;
+  for (int k = 0; k < samples && i <= c->nz; ++k) {
+    const float d = sigma * nv_fmax(rho[k], 0.0f) * it.delta; /* ms_view_step_depth's */
     if (!(d > 0.0f)) continue;
-    end = t + 0.5f * it.delta;
+    end = at[k] + 0.5f * it.delta;
     for (; i <= c->nz; ++i) {
       const float level = ms_view_level(t_end, i, c->nz);
       if (acc + d < level) break;
-      ms_view_store_level(cache, slice_stride, i, c->nz, level, ms_view_step_cross(t, it.delta, acc, d, level));
+      ms_view_store_level(cache, slice_stride, i, c->nz, level, ms_view_step_cross(at[k], it.delta, acc, d, level));
     }
     acc += d;
   }
