@@ -421,6 +421,14 @@ void DeviceMsCache::filterAll(ClRuntime& rt, const ms_cache_params& params, cons
   }
 }
 
+// One launch of `k` over every node (the reprojection's, the blend's), its time counted in the build and
+// the budget.
+void DeviceMsCache::launchEveryNode(ClRuntime& rt, const NamedKernel& k, const ms_cache_params& params) {
+  const double ms = launchOverNodes(rt, k.get(), nodeGridCount(params.grid), "the multiple-scattering cache", 3 * bytes_);
+  buildMs_ += ms;
+  budgetLeftMs_ -= ms;
+}
+
 // The camera move's prior: the cache drawn before it (previous_) read at the new nodes' points
 // (ms_cache_reproject.h, "Reprojection"), once every column is placed.
 void DeviceMsCache::reproject(ClRuntime& rt, const ms_cache_params& params) {
@@ -433,9 +441,7 @@ void DeviceMsCache::reproject(ClRuntime& rt, const ms_cache_params& params) {
   k.set("previous", previous_);
   k.set("placed", buffer_);
   k.set("prior", prior_);
-  const double ms = launchOverNodes(rt, k.get(), nodeGridCount(params.grid), "the multiple-scattering cache", 3 * bytes_);
-  buildMs_ += ms;
-  budgetLeftMs_ -= ms;
+  launchEveryNode(rt, k, params);
   reprojectPending_ = false;
   priorOn_ = true;
   blended_ = false;
@@ -461,9 +467,7 @@ void DeviceMsCache::blend(ClRuntime& rt, const ms_cache_params& params, int targ
   k.set("prior", prior_);
   k.set("fresh", filterOn_ ? front_ : buffer_);
   k.set("drawn", drawn_);
-  const double ms = launchOverNodes(rt, k.get(), nodeGridCount(params.grid), "the multiple-scattering cache", 3 * bytes_);
-  buildMs_ += ms;
-  budgetLeftMs_ -= ms;
+  launchEveryNode(rt, k, params);
   blended_ = true;
   blendedKey_ = key;
 }

@@ -85,6 +85,7 @@ class DeviceMsCache {
   // then drawn_, the prior blended with the new paths, until `done`.
   void reproject(ClRuntime& rt, const ms_cache_params& params);
   void blend(ClRuntime& rt, const ms_cache_params& params, int target, bool done);
+  void launchEveryNode(ClRuntime& rt, const NamedKernel& k, const ms_cache_params& params);
   // Budgeted slices (device_ms_cache.cpp).
   size_t activeBefore(size_t n) const;
   size_t sliceEnd(size_t first, size_t end, double units) const;
