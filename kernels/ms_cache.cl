@@ -57,8 +57,8 @@ __kernel void ms_cache_reproject_view(__constant scene_params* scene, ms_cache_p
                                       __global float* prior) {
   const int node = (int)get_global_id(0);
   if (node >= node_grid_count(&ms_cache.grid)) return;
-  ms_view_reproject_node(&scene->camera, scene->medium.phase, &previous_camera, &ms_cache, &previous_cache, previous, placed, node,
-                         prior + (size_t)node * MS_CACHE_STRIDE);
+  ms_view_reproject_node(&scene->camera, scene->medium.phase, &previous_camera, &ms_cache, &previous_cache, previous,
+                         placed, node, prior + (size_t)node * MS_CACHE_STRIDE);
 }
 
 /* The drawn cache while the new paths replace the reprojected prior (ms_cache_reproject.h, "Blend"): one

@@ -249,8 +249,10 @@ bool DeviceMsCache::place(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms
   while (placed_ < columns) {
     if (budgeted_ && budgetLeftMs_ <= 0) return false;
     // Budgeted in slices, but all at once under a camera move's prior, which needs every node placed.
-    const size_t end = budgeted_ && !reprojectPending_ ? std::min(columns, placed_ + std::max<size_t>(64, size_t(unitsThatFit(msPerPlace_, 1024, lastPlaced_))))
-                                 : columns;
+    const bool sliced = budgeted_ && !reprojectPending_;
+    const size_t end =
+        sliced ? std::min(columns, placed_ + std::max<size_t>(64, size_t(unitsThatFit(msPerPlace_, 1024, lastPlaced_))))
+               : columns;
     place.set("column_first", cl_uint(placed_));
     place.set("column_count", cl_uint(end - placed_));
     const double ms = launchOverNodes(rt, place.get(), end - placed_, "the multiple-scattering cache",

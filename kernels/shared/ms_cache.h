@@ -70,8 +70,9 @@
  * Storage: MS_CACHE_STRIDE floats per node. The running means of the paths so far: R (rgb), their count,
  * then b per channel (xyz, then a float: after red's the view layout's budget, after green's
  * MS_CACHE_SQUARE for the view filter's noise, after blue's the view column's background;
- * ms_cache_view.h; the view layout holds its turn where red's b is, and no b). Then, written by the build after each launch so that a lookup (one per march sample)
- * takes no logarithm or division per corner: ln R (MS_CACHE_LOG_R) and b/R (MS_CACHE_RATIO). Each launch
+ * ms_cache_view.h; the view layout holds its turn where red's b is, and no b). Then, written by the
+ * build after each launch so that a lookup (one per march sample) takes no logarithm or division per
+ * corner: ln R (MS_CACHE_LOG_R) and b/R (MS_CACHE_RATIO; the grid layout only). Each launch
  * adds `paths` paths per node (progressive: a viewer refines it over frames), path k of node n drawing
  * from its own stream (seed, n, k) and Sobol index k, so the cache after K paths is the same whatever
  * launches it was split into (ms_cache_build.h). */

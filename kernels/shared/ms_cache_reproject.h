@@ -18,8 +18,8 @@
  *
  * Direction: an old node holds the in-scattering towards the old camera, J(w_old), and the new pose
  * wants J(w_new), w the direction from the point to the camera. For an isotropic phase function they
- * are equal; for a peaked one (clouds' g 0.8: a lobe about 10° wide) they differ already at a few
- * degrees (bench/RESULTS.md). Each node also holds ∇J (MS_VIEW_TURN), estimated from its own paths by
+ * are equal; for a peaked one (HG's lobe is about 1 − g radians wide) they differ within a few degrees
+ * in a cloud (bench/RESULTS.md). Each node also holds ∇J (MS_VIEW_TURN), estimated from its own paths by
  * the score of their directions: J(w) = E[L·p(s·w)/q(s)] over directions s drawn with density q, so
  * ∇_w J = E[L·(p(s·w)/q(s))·(d ln p/dμ)·(s − μw)] (the likelihood-ratio estimator; the direct light's
  * own change is left out). The value read is J·(1 + ∇J·(w_new − w_old)/J), the first-order change,
@@ -85,7 +85,8 @@ static inline void ms_view_reproject_node(NV_CONSTANT const camera_params* cam, 
     NV_GLOBAL const float* o = col + (size_t)s * slice_stride;
     const vec3 J = vec3_make(o[0], o[1], o[2]);
     const float grey = vec3_average(J);
-    const float change = grey > 0.0f ? vec3_dot(vec3_make(o[MS_VIEW_TURN], o[MS_VIEW_TURN + 1], o[MS_VIEW_TURN + 2]), turn) / grey : 0.0f;
+    const vec3 gradient = vec3_make(o[MS_VIEW_TURN], o[MS_VIEW_TURN + 1], o[MS_VIEW_TURN + 2]);
+    const float change = grey > 0.0f ? vec3_dot(gradient, turn) / grey : 0.0f;
     sum = vec3_add(sum, vec3_scale(J, cols.w[k] * nv_fmin(2.0f, nv_fmax(0.5f, 1.0f + change))));
     const float v = grey > 0.0f ? nv_fmax(0.0f, o[MS_CACHE_SQUARE] - grey * grey) / (grey * grey) : 0.0f;
     count += cols.w[k] * (v < o[3] * x4 ? v / x4 : o[3]);

@@ -111,7 +111,8 @@ TEST(MsCacheMotion, AnOrbitDrawsTheReprojectionThenEndsAsTheCacheBuiltThere) {
   int seen = 0;
   for (int node = 0; node < nodeGridCount(params.grid); ++node) {
     const size_t at = size_t(node) * MS_CACHE_STRIDE;
-    ms_view_reproject_node(&newCamera, devAfter.scene.params.medium.phase, &oldCamera, &params, &params, drawnBefore.data(), placed.data(), node, expected.data() + at);
+    ms_view_reproject_node(&newCamera, devAfter.scene.params.medium.phase, &oldCamera, &params, &params,
+                           drawnBefore.data(), placed.data(), node, expected.data() + at);
     for (int i = 0; i < 4; ++i) ASSERT_NEAR(prior[at + i], expected[at + i], 1e-5f * (1 + std::fabs(expected[at + i])));
     seen += prior[at + 3] > 0;
   }
