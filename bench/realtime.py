@@ -205,13 +205,12 @@ def motion():
             t, (px, py, pz), (lx, _, lz) = math.radians(degrees), cam["position"], cam["lookAt"]
             x, z = (lx + (px - lx) * math.cos(t) + (pz - lz) * math.sin(t),
                     lz - (px - lx) * math.sin(t) + (pz - lz) * math.cos(t))
-            pose, stem = ["--set", "camera.position=[%r,%r,%r]" % (x, py, z)], out / ("%s_%g" % (name, degrees))
-            ref, there = refs / ("%s_%s_%g.exr" % (name, res, degrees)), stem.with_suffix(".built.exr")
-            if not ref.is_file():
-                b.render(a, scene, "--resolution", res, "--spp", a.ref_spp, "--seed", 7, *pose, out=ref)
+            pose, stem = ["--set", "camera.position=[%r,%r,%r]" % (x, py, z)], str(out / ("%s_%g" % (name, degrees)))
+            ref, there = refs / ("%s_%s_%g.exr" % (name, res, degrees)), Path(stem + ".built.exr")
+            b.reference(a, scene, ref, a.ref_spp, "--resolution", res, "--seed", 7, *pose)
             b.render(a, scene, *pick, *pose, out=there)
             for count in map(int, a.counts.split()):
-                runs = [(stem.with_suffix(".%d%s.exr" % (count, more and "reused")), more)
+                runs = [(Path("%s.%d%s.exr" % (stem, count, "reused" if more else "")), more)
                         for more in (["--ms-cache-in", baked], [])]
                 s = [b.render(a, scene, *pick, *pose, "--frames", count, "--target-ms", a.target_ms, *more, out=exr)
                      for exr, more in runs][0]
