@@ -108,7 +108,7 @@ MsCacheFile readMsCacheFile(const std::string& path, const std::string& flag, co
     s.placed = h.at("placed").get<uint64_t>();
     s.budgetMin = h.at("budget").at(0).get<int>();
     s.budgetMax = h.at("budget").at(1).get<int>();
-    s.camera = cameraFromJson(h.at("camera"));
+    if (h.contains("camera")) s.camera = cameraFromJson(h.at("camera"));  // absent before view files held it
   } catch (const nlohmann::json::exception&) {
     throw notACache;
   }
