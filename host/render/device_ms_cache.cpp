@@ -42,21 +42,23 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   filterOn_ = view && params.filter > 0;
   twicingOn_ = filterOn_ && params.filter_twicing;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
+  budgeted_ = budgetMs > 0;
+  budgetLeftMs_ = budgetMs;
   const std::string rest = key;
   key += rawBytes(c) + rawBytes(pathScene.camera);
   if (key != key_) {
     // Started over with as many nodes as before (a light or the medium changed; a view cache's camera
-    // without a budget), the old nodes are drawn until each takes its first new path, which replaces all that a lookup
-    // reads (the running mean's first step sets it; ms_cache_build.h): the picture is refreshed
+    // without a budget), the old nodes are drawn until each takes its first new path, which replaces
+    // all that a lookup reads (the running mean's first step sets it; ms_cache_build.h): the picture is refreshed
     // progressively, not thrown away, and the cache ends as one built from nothing, bit for bit.
     const bool keep = buffer_() && nodes * MS_CACHE_STRIDE * sizeof(float) == bytes_;
     // A view cache's camera or image size alone changed in a budgeted refine (a viewer's frame): what
     // was drawn is reprojected to the new nodes once they are placed, and drawn while their paths come
     // in (blend()). The running means start from zeros (the blend reads their counts).
-    const bool moved = view && budgetMs > 0 && rest == restKey_ && (paths_ > 0 || priorOn_) && !restore_;
+    const bool moved = view && budgeted_ && rest == restKey_ && (paths_ > 0 || priorOn_) && !restore_;
     if (moved) {  // the buffers of one move kept for the next (a viewer moves frame after frame)
-      if (previousBytes_ != bytes_) previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
-      previousBytes_ = bytes_;
+      if (!previous_() || previous_.getInfo<CL_MEM_SIZE>() != bytes_)
+        previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
       rt.queue.enqueueCopyBuffer(buffer(), previous_, 0, 0, bytes_);
       previousCamera_ = camera_;
       previousParams_ = placedParams_;
@@ -65,7 +67,7 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     }
     priorOn_ = blended_ = false;
     if (!keep || !moved) prior_ = drawn_ = cl::Buffer();
-    if (!moved) previous_ = cl::Buffer(), previousBytes_ = 0;
+    if (!moved) previous_ = cl::Buffer();
     bytes_ = nodes * MS_CACHE_STRIDE * sizeof(float);
     site_ = AllocationSite{sceneFile, view ? "renderer.raymarch.msCache.tile" : "renderer.raymarch.msCache.resolution",
                               "a multiple-scattering cache of " + std::to_string(c.nx) + "x" + std::to_string(c.ny) +
@@ -109,8 +111,6 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     placed_ = view ? 0 : size_t(-1);  // the view nodes' places, first (place())
     if (restore_) restore(rt, params);
   }
-  budgeted_ = budgetMs > 0;
-  budgetLeftMs_ = budgetMs;
   if (filterOn_ && filterPass_ > 0) filter(rt, params);  // a filtered copy under way first
   if (!place(rt, dev, params)) return;                   // budget spent before every column is placed
   if (reprojectPending_) reproject(rt, params);
@@ -142,7 +142,8 @@ MsCacheSnapshot DeviceMsCache::snapshot(ClRuntime& rt) const {
 
 // The pending snapshot into the cache just started (refine's start-over); a view layout's placed for
 // another camera becomes a camera move's prior (filtered first, as it would have been drawn), the
-// paths starting from none.
+// paths starting from none; without a budget it is let go, since the build runs to its paths before
+// anything is drawn.
 void DeviceMsCache::restore(ClRuntime& rt, const ms_cache_params& params) {
   const MsCacheSnapshot s = std::move(*restore_);
   restore_.reset();
@@ -150,8 +151,8 @@ void DeviceMsCache::restore(ClRuntime& rt, const ms_cache_params& params) {
     throw InputError("the multiple-scattering cache to restore holds " + std::to_string(s.nodes.size() / MS_CACHE_STRIDE) +
                      " nodes; this scene's has " + std::to_string(bytes_ / (MS_CACHE_STRIDE * sizeof(float))));
   if (params.layout == MS_CACHE_LAYOUT_VIEW && rawBytes(s.camera) != rawBytes(camera_)) {
+    if (!budgeted_) return;
     previous_ = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
-    previousBytes_ = bytes_;
     rt.queue.enqueueWriteBuffer(previous_, CL_TRUE, 0, bytes_, s.nodes.data());
     if (filterOn_) {
       const cl::Buffer means = previous_;
@@ -365,27 +366,15 @@ void DeviceMsCache::filter(ClRuntime& rt, const ms_cache_params& params) {
   for (cl::Buffer* b : {&front_, &back_, &mid_})
     if (!(*b)() && (b != &mid_ || twicingOn_)) *b = allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_);
   if (budgeted_) countActive(rt, params);
-  NamedKernel& filter = filterKernel_;
-  filter.set("ms_cache", params);
-  filter.set("cache", buffer_);
   const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);
   while (filterPass_ > 0) {
-    // S(J), then with twicing 2·S(J) − S(S(J)) from it, the weights both times the running means'
-    // (ms_cache_filter.h, "Twicing").
     const bool second = filterPass_ == 2;
     size_t end = columns;
     if (budgeted_) {
       if (budgetLeftMs_ <= 0) return;
       end = sliceEnd(filterColumn_, columns, unitsThatFit(msPerColumn_, 512, lastColumns_));
     }
-    filter.set("column_first", cl_uint(filterColumn_));
-    filter.set("column_count", cl_uint(end - filterColumn_));
-    filter.set("values", second ? mid_ : buffer_);
-    filter.set("residual", cl_int(second ? 1 : 0));
-    filter.set("filtered", twicingOn_ && !second ? mid_ : back_);
-    const double ms = launchOverNodes(rt, filter.get(), end - filterColumn_, "the multiple-scattering cache",
-                                      (second ? 3 : 2) * bytes_);
-    buildMs_ += ms;
+    const double ms = filterSlice(rt, params, buffer_, second, mid_, back_, filterColumn_, end);
     if (budgeted_) {
       lastColumns_ = std::max<size_t>(1, activeBefore(end) - activeBefore(filterColumn_));
       msPerColumn_ = std::max(1e-9, ms / double(lastColumns_));
@@ -406,21 +395,31 @@ void DeviceMsCache::filter(ClRuntime& rt, const ms_cache_params& params) {
   }
 }
 
-// The filtered copy of `means` into `out` in one go (the view layout's filter, twiced when it is on).
-void DeviceMsCache::filterAll(ClRuntime& rt, const ms_cache_params& params, const cl::Buffer& means, cl::Buffer& out) {
-  const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);
-  const cl::Buffer first = twicingOn_ ? allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_) : out;
+// Columns [first, end) of one filter pass over the running means `means` into `out`: S(J), or with
+// `second` twicing's 2·S(J) − S(S(J)) from the first pass's `mid` (the weights both times the means':
+// ms_cache_filter.h, "Twicing"); with twicing the first pass goes into `mid`. Its milliseconds.
+double DeviceMsCache::filterSlice(ClRuntime& rt, const ms_cache_params& params, const cl::Buffer& means, bool second,
+                                  const cl::Buffer& mid, const cl::Buffer& out, size_t first, size_t end) {
   NamedKernel& filter = filterKernel_;
   filter.set("ms_cache", params);
   filter.set("cache", means);
-  filter.set("column_first", cl_uint(0));
-  filter.set("column_count", cl_uint(columns));
-  for (int pass = 0; pass < (twicingOn_ ? 2 : 1); ++pass) {
-    filter.set("values", pass == 0 ? means : first);
-    filter.set("residual", cl_int(pass));
-    filter.set("filtered", pass == 0 ? first : out);
-    buildMs_ += launchOverNodes(rt, filter.get(), columns, "the multiple-scattering cache", 3 * bytes_);
-  }
+  filter.set("column_first", cl_uint(first));
+  filter.set("column_count", cl_uint(end - first));
+  filter.set("values", second ? mid : means);
+  filter.set("residual", cl_int(second ? 1 : 0));
+  filter.set("filtered", twicingOn_ && !second ? mid : out);
+  const double ms = launchOverNodes(rt, filter.get(), end - first, "the multiple-scattering cache",
+                                    (second ? 3 : 2) * bytes_);
+  buildMs_ += ms;
+  return ms;
+}
+
+// The filtered copy of `means` into `out` in one go (both passes with twicing).
+void DeviceMsCache::filterAll(ClRuntime& rt, const ms_cache_params& params, const cl::Buffer& means, cl::Buffer& out) {
+  const size_t columns = size_t(params.grid.nx) * size_t(params.grid.ny);
+  const cl::Buffer mid = twicingOn_ ? allocateBuffer(rt, CL_MEM_READ_WRITE, bytes_, site_) : cl::Buffer();
+  filterSlice(rt, params, means, false, mid, out, 0, columns);
+  if (twicingOn_) filterSlice(rt, params, means, true, mid, out, 0, columns);
 }
 
 // One launch of `k` over every node (the reprojection's, the blend's), its time counted in the build and
@@ -455,7 +454,6 @@ void DeviceMsCache::blend(ClRuntime& rt, const ms_cache_params& params, int targ
   if (done) {  // the buffers go with the prior (the cache is whole: a viewer has stopped moving)
     priorOn_ = blended_ = false;
     prior_ = drawn_ = previous_ = cl::Buffer();
-    previousBytes_ = 0;
     return;
   }
   if (filterOn_ && !frontReady_) return;

@@ -80,6 +80,8 @@ class DeviceMsCache {
   void filter(ClRuntime& rt, const ms_cache_params& params);
   bool place(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params);
   void restore(ClRuntime& rt, const ms_cache_params& params);
+  double filterSlice(ClRuntime& rt, const ms_cache_params& params, const cl::Buffer& means, bool second,
+                     const cl::Buffer& mid, const cl::Buffer& out, size_t first, size_t end);
   void filterAll(ClRuntime& rt, const ms_cache_params& params, const cl::Buffer& means, cl::Buffer& out);
   // A camera move's prior (ms_cache_reproject.h): previous_ into prior_, once the new nodes are placed;
   // then drawn_, the prior blended with the new paths, until `done`.
@@ -105,7 +107,6 @@ class DeviceMsCache {
   camera_params previousCamera_{};
   ms_cache_params placedParams_{}, previousParams_{};  // the start's (its nodes), and previous_'s
   cl::Buffer previous_, prior_, drawn_;
-  size_t previousBytes_ = 0;  // previous_'s size
   std::string blendedKey_;
   std::optional<MsCacheSnapshot> restore_;  // restoreAtStart's, until the start takes it
   AllocationSite site_;  // what an allocation failure names (the scene file and key)

@@ -141,6 +141,7 @@ static inline float ms_cache_running_mean(float mean, float x, uint k) {
  * (MS_VIEW_TURN; ms_cache_path). */
 static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, vec3 x,
                                         int node, NV_GLOBAL float* v, uint first, uint count) {
+  const int view = mc->layout == MS_CACHE_LAYOUT_VIEW;
   uint keys[MS_CACHE_LEADING_KEYS];
   ms_cache_leading_keys(ctx->scene->seed, node, keys);
   for (uint k = first; k < first + count; ++k) {
@@ -152,17 +153,17 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
     v[MS_CACHE_SQUARE] = ms_cache_running_mean(v[MS_CACHE_SQUARE], grey * grey, k);
     for (int ch = 0; ch < 3; ++ch) {
       v[ch] = ms_cache_running_mean(v[ch], Lc[ch], k);
-      if (mc->layout == MS_CACHE_LAYOUT_VIEW) continue;
+      if (view) continue;
       for (int a = 0; a < 3; ++a) v[4 + 4 * ch + a] = ms_cache_running_mean(v[4 + 4 * ch + a], Lc[ch] * w[a], k);
     }
-    if (mc->layout == MS_CACHE_LAYOUT_VIEW) {
+    if (view) {
       const float t[3] = {turn.x, turn.y, turn.z};
       for (int a = 0; a < 3; ++a) v[MS_VIEW_TURN + a] = ms_cache_running_mean(v[MS_VIEW_TURN + a], t[a], k);
     }
     v[3] = (float)(k + 1u);
   }
   /* What the grid layout's lookup reads (ms_cache.h, "Storage"). */
-  if (mc->layout == MS_CACHE_LAYOUT_VIEW) return;
+  if (view) return;
   for (int ch = 0; ch < 3; ++ch) {
     const float R = v[ch];
     v[MS_CACHE_LOG_R + ch] = R > 0.0f ? nv_log(R) : -NV_INFINITY;

@@ -70,11 +70,10 @@ static inline float ms_view_sigma_t(NV_CONSTANT const medium_params* m) {
   return (st.x + st.y + st.z) / 3.0f;
 }
 
-/* A march step's grey optical depth at sample t (its middle), and where in the step, τ linear over
+/* A march step's grey optical depth, `density` read at its middle, and where in the step, τ linear over
  * it, acc + d reaches `level`: the walk of the placement and of the path starts along a column. */
-static inline float ms_view_step_depth(KERNEL_CONTEXT_PARAM, NV_PRIVATE const medium_segment* seg, float sigma,
-                                       float t, float delta) {
-  return sigma * nv_fmax(grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg->o, seg->d, t)), 0.0f) * delta;
+static inline float ms_view_step_depth(float sigma, float density, float delta) {
+  return sigma * nv_fmax(density, 0.0f) * delta;
 }
 static inline float ms_view_step_cross(float t, float delta, float acc, float d, float level) {
   return t - 0.5f * delta + delta * nv_fmin(1.0f, nv_fmax(0.0f, (level - acc) / d));
@@ -134,7 +133,7 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
   int i = 0;
   float acc = 0.0f, end = seg.t0;
   for (int k = 0; k < samples && i <= c->nz; ++k) {
-    const float d = sigma * nv_fmax(rho[k], 0.0f) * it.delta; /* ms_view_step_depth's */
+    const float d = ms_view_step_depth(sigma, rho[k], it.delta);
     if (!(d > 0.0f)) continue;
     end = at[k] + 0.5f * it.delta;
     for (; i <= c->nz; ++i) {
@@ -167,7 +166,8 @@ static inline vec3 ms_view_sample_point(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
   if (seg.t1 > seg.t0) {
     march_iter it = march_begin(KERNEL_CONTEXT_ARG, &seg, MS_VIEW_SAMPLE_STEPS);
     while (march_next(&it, KERNEL_CONTEXT_ARG, &t)) {
-      const float d = ms_view_step_depth(KERNEL_CONTEXT_ARG, &seg, sigma, t, it.delta);
+      const float density = grid_density(KERNEL_CONTEXT_ARG, vec3_madd(seg.o, seg.d, t));
+      const float d = ms_view_step_depth(sigma, density, it.delta);
       if (!(d > 0.0f)) continue;
       if (acc + d >= target) {
         at = ms_view_step_cross(t, it.delta, acc, d, target);
