@@ -52,7 +52,8 @@ def series(algorithm, factor, meta):
         if algorithm == "pathtrace":
             opts = ["--bounces", v if factor == "bounces" else meta["bounces"]] + opts
         else:
-            opts = ["--set", "renderer.raymarch.steps=%d" % (v if factor == "steps" else meta["steps"])] + opts
+            steps = v if factor == "steps" else meta["steps"]
+            opts = ["--set", b.MARCH, "--set", "renderer.raymarch.steps=%d" % steps] + opts
         w, h = map(int, res.split("x"))
         x = w * h if factor == "pixels" else v ** 3 if factor == "grid" else v
         count = v if factor == "spp" else spp
@@ -79,7 +80,7 @@ def measure():
             "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
                                      text=True).stdout.strip() or "unknown"}
     a.narval = str(binary)
-    s = b.resolved_scene(a.narval, a.scene)
+    s = b.resolved_scene(a.narval, a.scene, [b.MARCH])
     volume = next(q["materialName"] for q in s["primitives"] if q["type"] == "volume")
     meta["material"] = next(i for i, m in enumerate(s["materials"]) if m["name"] == volume)
     meta["density"] = s["materials"][meta["material"]]["density"]

@@ -56,7 +56,7 @@ def measure():
     b.header("scene", "algorithm", names[0] + " s (median)", names[1] + " s (median)", names[2], "per-repetition")
     for label, first, second, inverse in pairs():
         for algorithm in a.algorithms.split():  # kernel seconds: the path tracer's, else the median frame's
-            count = ["--spp", a.spp] if algorithm == "pathtrace" else ["--frames", a.frames]
+            count = ["--spp", a.spp] if algorithm == "pathtrace" else ["--frames", a.frames, "--set", b.MARCH]
             common = ["--algorithm", algorithm, "--resolution", a.resolution, *count]
             runs = {i: (lambda s=s, o=o, e=e: b.seconds(b.render(a, s, *common, *o, env=e)))
                     for i, (s, o, e) in enumerate((first, second))}

@@ -36,7 +36,8 @@ def run():
             m["path"] = str(vdb)
     (a.work / "scene.json").write_text(json.dumps(scene, indent=1))
     for storage in a.storages.split():
-        for algorithm, count in (("pathtrace", ["--spp", a.spp]), ("raymarch", ["--frames", a.frames])):
+        for algorithm, count in (("pathtrace", ["--spp", a.spp]),
+                                 ("raymarch", ["--frames", a.frames, "--set", b.MARCH])):
             name = "%s-%s" % (algorithm, storage)
             stats, exr = a.work / (name + ".json"), a.work / (name + ".exr")
             steps.append((name, stats, measure(name, "render", a.work / "scene.json", "-o", exr,

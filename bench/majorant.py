@@ -34,8 +34,8 @@ def measure_scene(scene):
               "%.2fx" % (per_real["global"] / per_real[c]), "{:,}".format(counted[c]["density_lookups"]),
               "%.3f" % median[c], "%.2fx" % (median["global"] / median[c]), per)
     # raymarch: the same cells skip empty space.
-    ms = [b.render(a, scene, "--algorithm", "raymarch", "--resolution", a.resolution, "--frames", a.frames,
-                   "--majorant-resolution", c)["ms_per_frame"]["median"] for c in a.cells.split()]
+    ms = [b.render(a, scene, "--algorithm", "raymarch", "--set", b.MARCH, "--resolution", a.resolution,
+                   "--frames", a.frames, "--majorant-resolution", c)["ms_per_frame"]["median"] for c in a.cells.split()]
     print("\nraymarch ms/frame (median of %d) by cells: %s\n" % (
         a.frames, " ".join("%s: %.2f" % x for x in zip(a.cells.split(), ms))))
 

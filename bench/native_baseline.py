@@ -25,7 +25,8 @@ if not os.access(binaries["native"], os.X_OK):
 if a.frames < 2:
     p.error("--frames must be at least 2 (the first frame is excluded)")
 variants = [v for v in binaries if os.access(binaries[v], os.X_OK)]
-sets = [x for s in a.set for x in ("--set", s)]
+# The native build has no multiple-scattering cache: both draw the dissertation's march.
+sets = [x for s in [b.MARCH] + a.set for x in ("--set", s)]
 
 
 def run(program, scene, algorithm, resolution, spp, tag, *more):

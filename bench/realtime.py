@@ -46,10 +46,9 @@ out.mkdir(parents=True, exist_ok=True)
 
 
 def render(scene, algorithm, resolution, name, *sets):
-    """Renders into OUT/NAME.exr; its stats. The lobe is Eq. 7, what frames and tuning measure, unless a set
-    names the variant."""
-    if algorithm == "lobe" and not any(s.startswith("renderer.lobe.variant=") for s in sets):
-        sets = ('renderer.lobe.variant="eq7"',) + sets
+    """Renders into OUT/NAME.exr; its stats. What frames and tuning measure: the lobe as Eq. 7 and the ray
+    marcher as the dissertation's single-scattering march (b.MARCH)."""
+    sets = ({"lobe": 'renderer.lobe.variant="eq7"', "raymarch": b.MARCH}[algorithm],) + sets
     return b.render(a, scene, "--algorithm", algorithm, "--resolution", resolution, "--frames", a.frames,
                     sets=sets, out=out / (name + ".exr"))
 

@@ -19,6 +19,8 @@ REPO = Path(__file__).resolve().parent.parent
 # `narval compare` without a display transform (linear values clipped to [0, 1]): what the tables
 # recorded before compare took the scene's transform from the EXRs by default.
 LINEAR = ("--tonemap", "none", "--exposure", "0")
+# The ray marcher as the dissertation's single-scattering march (its multiple-scattering cache is the default).
+MARCH = 'renderer.raymarch.multipleScattering="none"'
 
 
 class NarvalError(RuntimeError):

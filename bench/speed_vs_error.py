@@ -19,16 +19,19 @@ import scene_env as b
 DEFAULT_SCENES = ["scenes/cloud.json", "scenes/smoke.json", "scenes/disney_cloud.json",
                   "scenes/disney_cloud_front.json"]
 REFERENCE_SEED, TEST_SEED = 1, 2
-CACHE = {"multipleScattering": "cache", "octaves": 1}
-VIEW = dict(CACHE, **{"msCache.layout": "view"})
+# The cache's methods as measured before its view layout became the default: named, not resolved.
+CACHE = {"multipleScattering": "cache", "octaves": 1, "msCache.layout": "grid", "msCache.direct": False}
+VIEW = dict(CACHE, **{"msCache.layout": "view", "msCache.filter": 0})
 METHODS = {  # algorithm, fixed settings, base parameters that differ from what narval resolves
     "pathtrace": ("pathtrace", {}, {}),
     "raymarch-none": ("raymarch", {"multipleScattering": "none", "octaves": 1}, {}),
     "raymarch-octaves": ("raymarch", {"multipleScattering": "octaves"}, {"octaves": 4}),
-    "raymarch-cache": ("raymarch", CACHE, {}),
-    "raymarch-cache-camera": ("raymarch", dict(CACHE, **{"msCache.closure": "camera"}), {}),
-    "raymarch-cache-view": ("raymarch", dict(VIEW, areaLightPhase="exact"), {"shadowWeighting": "phase"}),
-    "raymarch-cache-direct": ("raymarch", dict(VIEW, **{"msCache.direct": True}), {"msCache.tile": 2}),
+    "raymarch-cache": ("raymarch", CACHE, {"steps": 60, "msCache.paths": 256}),
+    "raymarch-cache-camera": ("raymarch", dict(CACHE, **{"msCache.closure": "camera"}), {"msCache.paths": 256}),
+    "raymarch-cache-view": ("raymarch", dict(VIEW, areaLightPhase="exact"),
+                            {"shadowWeighting": "phase", "msCache.tile": 4, "msCache.paths": 256}),
+    "raymarch-cache-direct": ("raymarch", dict(VIEW, **{"msCache.direct": True}),
+                              {"msCache.tile": 2, "msCache.paths": 256}),
     "raymarch-cache-filtered": ("raymarch", dict(VIEW, **{"msCache.direct": True, "msCache.tile": 1}),
                                 {"msCache.paths": 160, "msCache.filter": 1, "msCache.filterTolerance": 2}),
     "lobe-eq7": ("lobe", {"variant": "eq7"}, {}),

@@ -59,9 +59,9 @@ lobe_params lobeParams(const LobeSettings& l) {
 }
 
 // The view layout aims its paths at the camera (closure camera) and filters its columns.
-ms_cache_params msCacheParams(const MsCacheSettings& mc, bool on, const DeviceScene& ds) {
+ms_cache_params msCacheParams(const MsCacheSettings& mc, int tile, bool on, const DeviceScene& ds) {
   ms_cache_params p{};
-  p.tile = mc.tile;
+  p.tile = tile;
   switch (mc.layout) {
     case MsCacheLayout::Grid:
       p.layout = MS_CACHE_LAYOUT_GRID;
@@ -70,8 +70,8 @@ ms_cache_params msCacheParams(const MsCacheSettings& mc, bool on, const DeviceSc
     case MsCacheLayout::View:  // columns over the image, slices along them (ms_cache_view.h)
       p.layout = MS_CACHE_LAYOUT_VIEW;
       if (on && ds.params.has_medium) {
-        p.grid.nx = (ds.params.camera.width + mc.tile - 1) / mc.tile;
-        p.grid.ny = (ds.params.camera.height + mc.tile - 1) / mc.tile;
+        p.grid.nx = (ds.params.camera.width + tile - 1) / tile;
+        p.grid.ny = (ds.params.camera.height + tile - 1) / tile;
         p.grid.nz = mc.slices;
       }
       p.filter = mc.filter;
@@ -97,13 +97,25 @@ ms_cache_params msCacheParams(const MsCacheSettings& mc, bool on, const DeviceSc
 
 }  // namespace
 
-RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes, double cachePixels) {
+int msCacheTile(const RaymarchSettings& raymarch, double pixels, bool gpu) {
+  if (raymarch.msCache.tile != kMsCacheTileAuto) return raymarch.msCache.tile;
+  if (gpu) return 1;
+  const double columns = raymarchQualityDefaults(raymarch.quality).cpuColumns;
+  int tile = 1;
+  while (pixels / (double(tile) * tile) > columns) ++tile;
+  return tile;
+}
+
+RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes, double cachePixels,
+                              bool gpu) {
   const RendererSettings& r = scene.renderer;
+  const double pixels = cachePixels > 0 ? cachePixels : double(r.width) * double(r.height);
   RealtimeParams p;
   switch (r.algorithm) {
     case Algorithm::Raymarch:
       p.march = raymarchMarch(r.raymarch);
-      p.msCache = msCacheParams(r.raymarch.msCache, r.raymarch.multipleScattering == MultipleScattering::Cache, ds);
+      p.msCache = msCacheParams(r.raymarch.msCache, msCacheTile(r.raymarch, pixels, gpu),
+                                r.raymarch.multipleScattering == MultipleScattering::Cache, ds);
       break;
     case Algorithm::Lobe:
       p.march = lobeMarch(r.lobe);
@@ -113,7 +125,6 @@ RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t 
   }
   // No light loop when the multiple-scattering cache holds the direct light: no shadow rays to cache.
   // A pixel reads a shadow per light at each view step (the ray marcher) or lobe point (the lobe).
-  const double pixels = cachePixels > 0 ? cachePixels : double(r.width) * double(r.height);
   const double raysPerPixel = std::max(1, r.algorithm == Algorithm::Lobe ? p.lobe.points : p.march.steps);
   if (!p.msCache.direct)
     p.lightCache = lightCacheLayout(ds, r.lightCache.resolution, pixels * raysPerPixel, maxAllocBytes);

@@ -22,9 +22,13 @@ struct RealtimeParams {
 
 // The blocks for the scene's algorithm; the caches' layouts need the scene as uploaded.
 // maxAllocBytes: the device's largest allocation, which an automatic cache resolution must fit.
-// cachePixels: the image size the automatic light cache is weighed against (lightCacheLayout); 0 takes
-// the scene's own resolution.
+// cachePixels: the image size the automatic caches are weighed against (lightCacheLayout, msCacheTile);
+// 0 takes the scene's own resolution. gpu: the device is a GPU.
 RealtimeParams realtimeParams(const Scene& scene, const DeviceScene& ds, size_t maxAllocBytes = SIZE_MAX,
-                              double cachePixels = 0);
+                              double cachePixels = 0, bool gpu = false);
+
+// msCache.tile, "auto" resolved: a column a pixel on a GPU; on a CPU the smallest tile that leaves the
+// image of `pixels` at most the quality's columns (a build of minutes, not hours, on a few cores).
+int msCacheTile(const RaymarchSettings& raymarch, double pixels, bool gpu);
 
 }  // namespace narval

@@ -69,7 +69,8 @@ void RealtimeRenderer::setView(const Scene& view) {
   }
   // Each kernel takes the blocks of its features (realtime_params.h); a cache that is off reads a
   // placeholder, never touched.
-  const RealtimeParams params = realtimeParams(view, dev_.scene, rt_.selected.info.maxAllocBytes, cachePixels_);
+  const RealtimeParams params = realtimeParams(view, dev_.scene, rt_.selected.info.maxAllocBytes, cachePixels_,
+                                                rt_.selected.info.type == "GPU");
   kernel_.set("march", params.march);
   kernel_.set("light_cache", params.lightCache);
   if (params.lightCache.nx == 0) kernel_.set("light_cache_nodes", noCache_);

@@ -30,6 +30,9 @@ const EnumNames<ShadowWeighting> kShadowWeightings = {{"area", ShadowWeighting::
 const EnumNames<MsCacheLayout> kMsCacheLayouts = {{"grid", MsCacheLayout::Grid}, {"view", MsCacheLayout::View}};
 const EnumNames<MsCacheAllocationKind> kMsCacheAllocations = {{"even", MsCacheAllocationKind::Even},
                                                               {"perceptual", MsCacheAllocationKind::Perceptual}};
+const EnumNames<RaymarchQuality> kRaymarchQualities = {{"draft", RaymarchQuality::Draft},
+                                                        {"interactive", RaymarchQuality::Interactive},
+                                                        {"high", RaymarchQuality::High}};
 const EnumNames<LobeVariant> kLobeVariants = {{"eq7", LobeVariant::Eq7}, {"corrected", LobeVariant::Corrected}};
 #define ALGORITHM_NAME(cxx, name, realtime) {name, Algorithm::cxx},
 const EnumNames<Algorithm> kAlgorithms = {ALGORITHMS(ALGORITHM_NAME)};
@@ -121,8 +124,18 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
     ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
   s.interpolation = readEnum(mc, "interpolation", kMsCacheInterpolations, s.interpolation);
   s.resolution = readInt(mc, "resolution", s.resolution, 1, 256);
-  s.tile = readInt(mc, "tile", s.tile, 1, 256);
-  s.direct = mc.getBool("direct", s.direct);
+  mc.note("tile", "integer or string", s.tile == kMsCacheTileAuto ? json("auto") : json(s.tile), "\"auto\", or [1, 256]");
+  if (const json* tile = mc.find("tile")) {
+    if (tile->is_string() && tile->get<std::string>() == "auto")
+      s.tile = kMsCacheTileAuto;
+    else if (tile->is_number())
+      s.tile = static_cast<int>(checkIntRange(ctx, mc.keyOf("tile"), toInteger(ctx, *tile, mc.keyOf("tile")), 1, 256));
+    else
+      ctx.fail(mc.keyOf("tile"), "expected \"auto\" or pixels per column side, got " +
+                                     (tile->is_string() ? "\"" + tile->get<std::string>() + "\"" : std::string(tile->type_name())));
+  }
+  // The direct light in the cache where a node can hold it (the camera's direction), else the march's.
+  s.direct = mc.getBool("direct", view || s.closure == MsCacheClosure::Camera);
   if (s.direct && !view && s.closure != MsCacheClosure::Camera)
     ctx.fail(mc.keyOf("direct"), "needs closure \"camera\" or layout \"view\" (a node must hold the light "
                                  "scattered towards the camera)");
@@ -156,11 +169,17 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   return s;
 }
 
+
 RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::string& key, RaymarchSettings s) {
   ObjectReader m(ctx, value, key);
-  s.steps = readInt(m, "steps", s.steps, 1);
-  s.shadowSteps = readInt(m, "shadowSteps", s.shadowSteps, 1);
+  s.quality = readEnum(m, "quality", kRaymarchQualities, s.quality);
+  const RaymarchQualityDefaults quality = raymarchQualityDefaults(s.quality);
   s.octaves = readInt(m, "octaves", s.octaves, 1, 16);
+  s.multipleScattering = readEnum(m, "multipleScattering", kMultipleScattering,
+                                  s.octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::Cache);
+  const bool cache = s.multipleScattering == MultipleScattering::Cache;
+  s.steps = readInt(m, "steps", cache ? quality.steps : s.steps, 1);
+  s.shadowSteps = readInt(m, "shadowSteps", s.shadowSteps, 1);
   s.octaveScattering = readUnitInterval(m, "octaveScattering", s.octaveScattering);
   s.octaveExtinction = readUnitInterval(m, "octaveExtinction", s.octaveExtinction);
   s.octavePhase = readUnitInterval(m, "octavePhase", s.octavePhase);
@@ -172,8 +191,6 @@ RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::st
   s.areaLightPhase = readAreaLightPhase(m, s.areaLightPhase);
   s.shadowAreaSamples = readInt(m, "shadowAreaSamples", s.shadowAreaSamples, 1, 16);
   s.shadowWeighting = readEnum(m, "shadowWeighting", kShadowWeightings, s.shadowWeighting);
-  s.multipleScattering = readEnum(m, "multipleScattering", kMultipleScattering,
-                                  s.octaves > 1 ? MultipleScattering::Octaves : MultipleScattering::None);
   if (s.octaves > 1 && s.multipleScattering != MultipleScattering::Octaves)
     ctx.fail(m.keyOf("octaves"), "applies only with multipleScattering \"octaves\"");
   const char* ms = enumName(kMultipleScattering, s.multipleScattering);
@@ -181,8 +198,9 @@ RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::st
     for (const char* k : {"octaveScattering", "octaveExtinction", "octavePhase"})
       ctx.warnIfChanged(m.keyOf(k),
                         std::string("applies to multipleScattering \"octaves\"; \"") + ms + "\" ignores it");
+  s.msCache.paths = quality.paths;
   s.msCache = readMsCache(ctx, section(m, "msCache"), m.keyOf("msCache"), s.msCache);
-  if (s.multipleScattering != MultipleScattering::Cache && ctx.changedUnder(m.keyOf("msCache")))
+  if (!cache && ctx.changedUnder(m.keyOf("msCache")))
     ctx.warn(m.keyOf("msCache"), std::string("applies to multipleScattering \"cache\"; \"") + ms + "\" ignores it");
   m.reportUnknown();
   return s;
@@ -293,5 +311,14 @@ int lobeDefault(const LobeSettings& l, int value, int eq7, int corrected) {
 
 int lobeViewSteps(const LobeSettings& l) { return lobeDefault(l, l.viewSteps, 24, 16); }
 int lobeShadowAreaSamples(const LobeSettings& l) { return lobeDefault(l, l.shadowAreaSamples, 1, 4); }
+
+RaymarchQualityDefaults raymarchQualityDefaults(RaymarchQuality q) {
+  switch (q) {  // the interactive one is the cloud's and the smoke's pick (bench/RESULTS.md)
+    case RaymarchQuality::Draft: return {20, 32, 160.0 * 120};
+    case RaymarchQuality::Interactive: return {30, 100, 320.0 * 240};
+    case RaymarchQuality::High: return {60, 400, 640.0 * 480};
+  }
+  throw std::logic_error("raymarchQualityDefaults: unknown quality");
+}
 
 }  // namespace narval

@@ -111,32 +111,43 @@ enum class MsCacheLayout { Grid, View };
 // How the view layout spreads its paths over its columns: the same number each, or by what their
 // noise costs the eye (host/render/ms_cache_allocation.h).
 enum class MsCacheAllocationKind { Even, Perceptual };
+// renderer.raymarch.quality: what the multiple-scattering cache's defaults aim for. Each sets the
+// march's steps (with the cache on), the cache's paths per node and, for msCache.tile "auto", how
+// many columns a CPU device gets (realtime_params.h, msCacheTile); explicit keys override it.
+enum class RaymarchQuality { Draft, Interactive, High };
+struct RaymarchQualityDefaults {
+  int steps, paths;
+  double cpuColumns;  // the most view-cache columns on a CPU device (a GPU takes a column a pixel)
+};
+RaymarchQualityDefaults raymarchQualityDefaults(RaymarchQuality q);
 
+constexpr int kMsCacheTileAuto = 0;
 struct MsCacheSettings {
   MsCacheClosure closure = MsCacheClosure::Linear;
   MsCacheInterpolation interpolation = MsCacheInterpolation::Geometric;
-  MsCacheLayout layout = MsCacheLayout::Grid;
+  MsCacheLayout layout = MsCacheLayout::View;
   int resolution = 16;      // grid: cells on the medium box's longest axis
-  int tile = 4;             // view: pixels per column side
+  int tile = kMsCacheTileAuto;  // view: pixels per column side (auto: realtime_params.h, msCacheTile)
   int slices = 8;           // view: nodes per column
   // The lights' unscattered light: added by the march (false) or held by the cache with the rest
   // (kernels/shared/ms_cache.h, "Direct"; closure "camera" or layout "view" only).
-  bool direct = false;
+  bool direct = true;  // the default where it applies (layout view or closure camera), else false
   // view: the node filter (kernels/shared/ms_cache_filter.h): σ_s in columns (0: off) and k, the
   // standard errors by which a neighbour may differ before it loses weight.
-  float filter = 0;
-  float filterTolerance = 1;
+  float filter = 1.5f;
+  float filterTolerance = 2;
   bool filterTwicing = false;  // the filter's residual filtered and added back (ms_cache_filter.h, "Twicing")
   // closure "camera" or layout "view": the share of each path's first direction drawn about the
   // directions to the lights instead of by the phase function (kernels/shared/phase_guide.h); 0: none.
   float guide = 0;
   MsCacheAllocationKind allocation = MsCacheAllocationKind::Even;  // view only
-  int paths = 256;          // paths per node (allocated: their mean over the nodes holding medium)
+  int paths = 100;          // paths per node (allocated: their mean over the nodes holding medium); default: the quality's
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
 };
 
 struct RaymarchSettings {
-  int steps = 60;
+  RaymarchQuality quality = RaymarchQuality::Interactive;
+  int steps = 60;  // the dissertation's march; with the cache on, the quality's
   int shadowSteps = 10;
   // Multiple-scattering octaves (Wrenninge et al. 2013; Hillaire 2016): octave i uses σs·aⁱ,
   // σt·bⁱ and g·cⁱ. 1 = plain single scattering. a <= b keeps it energy-conserving.
@@ -146,8 +157,8 @@ struct RaymarchSettings {
   float octavePhase = 0.5f;       // c
   // The view march stops once every channel's transmittance is below this (error bound: raymarch.h); 0: never.
   float minTransmittance = 1e-3f;
-  // Absent from the scene: Octaves when octaves > 1, else None.
-  MultipleScattering multipleScattering = MultipleScattering::None;
+  // Absent from the scene: Octaves when octaves > 1, else Cache (None is the dissertation's march).
+  MultipleScattering multipleScattering = MultipleScattering::Cache;
   MsCacheSettings msCache;
   // A rectangle light is K×K points for the phase and 1/d² (march.h, march_light_phase_sum: K² evaluations a
   // sample; 1 = its centre, the dissertation's) and for its shadow (march_light_column: light cache build only).

@@ -1,6 +1,7 @@
 // scene_keys.cpp: the scene format's key table, learnt from the loader itself. Two scenes that
 // between them take every branch of the loader (a material per phase function and per kind of
-// emission, a primitive per light kind, both Lobe Estimator variants, both cache layouts) are read
+// emission, a primitive per light kind, both Lobe Estimator variants, both cache layouts, the march
+// with and without the cache) are read
 // with the volume files not looked for; every key looked up leaves its type, default and range
 // (json_reader.h, KeyRecord). docs/scene-format.md is checked against this table.
 #include <algorithm>
@@ -56,7 +57,7 @@ std::vector<SceneKey> sceneKeyTable() {
       {{"resolution", {8, 8}}},
       {{"resolution", {8, 8}},
        {"algorithm", "raymarch"},
-       {"raymarch", {{"multipleScattering", "cache"}, {"msCache", {{"layout", "view"}}}}},
+       {"raymarch", {{"multipleScattering", "none"}, {"msCache", {{"layout", "grid"}}}}},  // not the defaults
        {"lobe", {{"variant", LobeSettings{}.variant == LobeVariant::Eq7 ? "corrected" : "eq7"}}}},  // not the default
   };
   std::map<std::string, SceneKey> table;

@@ -143,7 +143,7 @@ TEST_F(Cli, SceneResolvedAndKeys) {
   EXPECT_EQ(r.err, "");
   const nlohmann::json doc = nlohmann::json::parse(r.out);
   EXPECT_EQ(doc["renderer"]["spp"], 7);
-  EXPECT_EQ(doc["renderer"]["raymarch"]["steps"], 60);
+  EXPECT_EQ(doc["renderer"]["raymarch"]["steps"], 30);  // with the cache, at the interactive quality
   write("resolved.json", r.out);
   EXPECT_EQ(run("scene resolved.json --resolved").out, r.out);
 

@@ -70,12 +70,11 @@ TEST_F(FlagsCli, SamplesAndBouncesOnlyWhereTheyApply) {
   expectRefused("render s.json --algorithm lobe --bounces 3",
                 "narval: --bounces: does not apply to lobe (only the ray marcher's multiple-scattering cache "
                 "traces bounces)\n");
-  expectRefused("render s.json --algorithm raymarch --bounces 3",
+  expectRefused("render s.json --algorithm raymarch --bounces 3 --set renderer.raymarch.multipleScattering=none",
                 "narval: --bounces: does not apply to raymarch (only the ray marcher's multiple-scattering cache "
                 "traces bounces)\n");
-  const test::RunResult r = run("render s.json --algorithm raymarch --bounces 3 --set "
-                                "renderer.raymarch.multipleScattering=cache --set renderer.raymarch.msCache.paths=4 "
-                                "--set renderer.raymarch.msCache.resolution=2 --stats-json st.json -o r.exr");
+  const test::RunResult r = run("render s.json --algorithm raymarch --bounces 3 --set renderer.raymarch.msCache.paths=4 "
+                                "--stats-json st.json -o r.exr");  // the cache, by default
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(test::readFile(dir_ / "st.json"))["bounces"], 3);
 }

@@ -17,7 +17,8 @@ class LightCacheCli : public CliFixture {
  protected:
   void SetUp() override {
     ASSERT_EQ(run("make-cloud c.vdb --resolution 24 --seed 4").code, 0);
-    // Two lights (a rectangle facing the cloud and a point light) over a cubic box.
+    // Two lights (a rectangle facing the cloud and a point light) over a cubic box; the dissertation's
+    // march, whose shadows the light cache serves (the multiple-scattering cache is named where used).
     write("s.json", R"({
       "materials": [
         {"name": "light", "type": "emitter", "albedo": [6, 6, 6]},
@@ -32,7 +33,8 @@ class LightCacheCli : public CliFixture {
         {"name": "box", "type": "volume", "transform": {"scale": [2, 2, 2]}, "materialName": "cloud"}
       ],
       "camera": {"position": [0, 0, -6], "lookAt": [0, 0, 0], "vfov": 30},
-      "renderer": {"resolution": [24, 18], "algorithm": "raymarch", "lightCache": {"resolution": 32}},
+      "renderer": {"resolution": [24, 18], "algorithm": "raymarch", "lightCache": {"resolution": 32},
+                   "raymarch": {"multipleScattering": "none"}},
       "background": [0.05, 0.05, 0.1]
     })");
   }
@@ -72,8 +74,8 @@ TEST_F(LightCacheCli, FramesBuildTheCacheOnceAndTheStatsReportIt) {
 // The ray marcher's multiple-scattering cache: built once before the frames and reported apart.
 TEST_F(LightCacheCli, TheMultipleScatteringCacheIsBuiltOnceAndReported) {
   const RunResult r = run("render s.json -o m.exr --frames 3 --stats-json m.json --set "
-                          "renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
-                          "--set renderer.raymarch.msCache.paths=6 --set renderer.raymarch.msCache.pathsPerLaunch=4");
+                          "renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"grid\\\" "
+                          "--set renderer.raymarch.msCache.resolution=4 --set renderer.raymarch.msCache.paths=6 --set renderer.raymarch.msCache.pathsPerLaunch=4");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json s = stats("m.json");
   EXPECT_EQ(s["ms_cache_cells"], nlohmann::json::array({4, 4, 4}));
@@ -82,7 +84,7 @@ TEST_F(LightCacheCli, TheMultipleScatteringCacheIsBuiltOnceAndReported) {
   EXPECT_GT(s["ms_cache_ms"].get<double>(), 0.0);
   EXPECT_NE(r.out.find("\nmultiple-scattering cache: 4x4x4 cells, 6 paths per node in "), std::string::npos) << r.out;
   ASSERT_EQ(run("render s.json -o n.exr --stats-json n.json").code, 0);
-  EXPECT_EQ(stats("n.json")["ms_cache_builds"], 0);  // none by default
+  EXPECT_EQ(stats("n.json")["ms_cache_builds"], 0);  // none in this scene
   const ImageRGB cached = readExr((dir_ / "m.exr").string()), plain = readExr((dir_ / "n.exr").string());
   double sumCached = 0, sumPlain = 0;
   for (size_t i = 0; i < cached.rgb.size(); ++i) sumCached += cached.rgb[i], sumPlain += plain.rgb[i];
@@ -95,7 +97,8 @@ TEST_F(LightCacheCli, TheMultipleScatteringCacheIsBuiltOnceAndReported) {
 // sweeps of 1, 1, 2, 2 paths: at most 500 slices) the image is the unbudgeted render's, bit for bit.
 // Where the flag cannot apply: one line, exit 2, nothing written.
 TEST_F(LightCacheCli, ABudgetBuildsTheCacheOverTheFramesToTheSameImage) {
-  const std::string cache = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
+  const std::string cache = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"grid\\\" "
+                            "--set renderer.raymarch.msCache.resolution=4 "
                             "--set renderer.raymarch.msCache.paths=6";
   RunResult r = run("render s.json -o p.exr --frames 2 --target-ms 0.001 --stats-json p.json" + cache);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -112,7 +115,8 @@ TEST_F(LightCacheCli, ABudgetBuildsTheCacheOverTheFramesToTheSameImage) {
 
   r = run("render s.json -o w.exr --frames 2 --target-ms 50 --algorithm lobe");
   EXPECT_EQ(r.code, 0);
-  EXPECT_EQ(r.err, "narval: warning: --target-ms: only the ray marcher's multiple-scattering cache is built within "
+  EXPECT_EQ(r.err, "narval: warning: s.json: renderer.raymarch: applies to algorithm \"raymarch\"; algorithm \"lobe\" "
+                   "ignores it\nnarval: warning: --target-ms: only the ray marcher's multiple-scattering cache is built within "
                    "a frame budget; this scene's lobe has none, so every frame is drawn whole\n");
   r = run("render s.json -o x.exr --target-ms 50");
   EXPECT_EQ(r.code, 2);
@@ -132,7 +136,8 @@ TEST_F(LightCacheCli, ABudgetBuildsTheCacheOverTheFramesToTheSameImage) {
 // build at all, the very image a cache built there gives, bit for bit. A cache of 4 paths read
 // with `paths` 8 goes on to 8 and equals a cache built to 8 in one go.
 TEST_F(LightCacheCli, ACacheFileBuiltAtOnePoseDrawsAnother) {
-  const std::string cache = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
+  const std::string cache = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"grid\\\" "
+                            "--set renderer.raymarch.msCache.resolution=4 "
                             "--set renderer.raymarch.msCache.paths=";
   ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out baked/a.mscache" + cache + "4").code, 0);
   ASSERT_TRUE(std::filesystem::exists(dir_ / "baked/a.mscache"));  // its folder made
@@ -181,10 +186,11 @@ TEST_F(LightCacheCli, AViewCacheFileReadAtAnotherPoseIsDrawnReprojected) {
 // the camera (closure camera), and another image size for the view layout (its columns are the
 // image's); so are what is not a cache file and the flags where no cache is drawn.
 TEST_F(LightCacheCli, ACacheFileIsRefusedForAnotherSceneNamingWhatDiffers) {
-  const std::string grid = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.resolution=4 "
+  const std::string grid = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"grid\\\" "
+                            "--set renderer.raymarch.msCache.resolution=4 "
                            "--set renderer.raymarch.msCache.paths=2";
   const std::string view = " --set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\" "
-                           "--set renderer.raymarch.msCache.paths=2";
+                           "--set renderer.raymarch.msCache.tile=4 --set renderer.raymarch.msCache.paths=2";
   ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out g.mscache" + grid).code, 0);
   ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out v.mscache" + view).code, 0);
   ASSERT_EQ(run("render s.json -o a.exr --ms-cache-out c.mscache" + grid + " --set renderer.raymarch.msCache.closure=\\\"camera\\\"").code, 0);
@@ -207,7 +213,8 @@ TEST_F(LightCacheCli, ACacheFileIsRefusedForAnotherSceneNamingWhatDiffers) {
       {"--ms-cache-in s.json" + grid,
        "narval: --ms-cache-in: s.json: not a multiple-scattering cache (narval render --ms-cache-out writes one)\n"},
       {"--ms-cache-in g.mscache --algorithm lobe",
-       "narval: --ms-cache-in: only the ray marcher's multiple-scattering cache is kept in a file; the scene has none "
+       "narval: warning: s.json: renderer.raymarch: applies to algorithm \"raymarch\"; algorithm \"lobe\" ignores "
+       "it\nnarval: --ms-cache-in: only the ray marcher's multiple-scattering cache is kept in a file; the scene has none "
        "(algorithm raymarch, renderer.raymarch.multipleScattering \"cache\")\n"},
       {"--ms-cache-out o.mscache",
        "narval: --ms-cache-out: only the ray marcher's multiple-scattering cache is kept in a file; the scene has none "
@@ -227,7 +234,8 @@ TEST_F(LightCacheCli, ACacheFileIsRefusedForAnotherSceneNamingWhatDiffers) {
 TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
   const RunResult r = run("render s.json -o v.exr --stats-json v.json --set "
                           "renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\" "
-                          "--set renderer.raymarch.msCache.paths=4 --set renderer.raymarch.msCache.resolution=8");
+                          "--set renderer.raymarch.msCache.tile=4 --set renderer.raymarch.msCache.paths=4 "
+                          "--set renderer.raymarch.msCache.resolution=8");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err, "narval: warning: s.json: renderer.raymarch.msCache.resolution: applies to layout \"grid\"; "
                    "\"view\" ignores it\n");
@@ -236,7 +244,8 @@ TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
   EXPECT_EQ(s["ms_cache_layout"], "view");
   EXPECT_EQ(s["ms_cache_paths"], 4);
   EXPECT_EQ(s["nan_pixels"], 0);
-  EXPECT_NE(r.out.find("\nmultiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node in "),
+  EXPECT_NE(r.out.find("multiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
+                       "1.5 columns, tolerance 2 standard errors) in "),
             std::string::npos)
       << r.out;
 }
@@ -246,18 +255,19 @@ TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
 TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   const std::string cache =
       "--set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.paths=4 "
-      "--set renderer.raymarch.msCache.filter=1.5 --set renderer.raymarch.msCache.filterTolerance=2 ";
+      "--set renderer.raymarch.msCache.tile=4 --set renderer.raymarch.msCache.filter=1 "
+      "--set renderer.raymarch.msCache.filterTolerance=3 ";
   RunResult r = run("render s.json -o v.exr --stats-json v.json " + cache +
                     "--set renderer.raymarch.msCache.layout=\\\"view\\\"");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   nlohmann::json s = stats("v.json");
-  EXPECT_EQ(s["ms_cache_filter"], 1.5);
-  EXPECT_EQ(s["ms_cache_filter_tolerance"], 2.0);
+  EXPECT_EQ(s["ms_cache_filter"], 1.0);
+  EXPECT_EQ(s["ms_cache_filter_tolerance"], 3.0);
   EXPECT_EQ(s["ms_cache_filter_twicing"], false);
   EXPECT_EQ(s["nan_pixels"], 0);
-  EXPECT_NE(r.out.find("\nmultiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
-                       "1.5 columns, tolerance 2 standard errors) in "),
+  EXPECT_NE(r.out.find("multiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
+                       "1 columns, tolerance 3 standard errors) in "),
             std::string::npos)
       << r.out;
   r = run("render s.json -o t.exr --stats-json t.json " + cache +
@@ -266,7 +276,7 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   EXPECT_EQ(r.err, "");
   EXPECT_EQ(stats("t.json")["ms_cache_filter_twicing"], true);
   EXPECT_EQ(stats("t.json")["nan_pixels"], 0);
-  EXPECT_NE(r.out.find(", filtered (sigma 1.5 columns, tolerance 2 standard errors, twiced) in "), std::string::npos)
+  EXPECT_NE(r.out.find(", filtered (sigma 1 columns, tolerance 3 standard errors, twiced) in "), std::string::npos)
       << r.out;
   // The perceptual allocation (render/ms_cache_allocation.h): a mean of 4 paths, a pilot of 1, the
   // budgets within [0.625, 2.5] of the mean, reported in the line and the stats.
@@ -280,13 +290,15 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   EXPECT_LE(budget[1].get<int>(), 10);
   EXPECT_LE(budget[0].get<int>(), budget[1].get<int>());
   EXPECT_EQ(stats("a.json")["ms_cache_paths"], 4);
-  EXPECT_NE(r.out.find("columns x rows x slices, a mean of 4 paths per node, filtered (sigma 1.5 columns, tolerance 2 "
+  EXPECT_NE(r.out.find("columns x rows x slices, a mean of 4 paths per node, filtered (sigma 1 columns, tolerance 3 "
                        "standard errors), allocated perceptually ("),
             std::string::npos)
       << r.out;
-  r = run("render s.json -o g.exr --stats-json g.json " + cache);
+  r = run("render s.json -o g.exr --stats-json g.json " + cache + "--set renderer.raymarch.msCache.layout=\\\"grid\\\"");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err,
+            "narval: warning: s.json: renderer.raymarch.msCache.tile: applies to layout \"view\"; \"grid\" "
+            "ignores it\n"
             "narval: warning: s.json: renderer.raymarch.msCache.filter: applies to layout \"view\"; \"grid\" "
             "ignores it\n"
             "narval: warning: s.json: renderer.raymarch.msCache.filterTolerance: applies to layout \"view\"; "
@@ -300,13 +312,14 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
 TEST_F(LightCacheCli, TheGuideIsReported) {
   const std::string cache =
       "--set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.paths=4 "
-      "--set renderer.raymarch.msCache.layout=\\\"view\\\" ";
+      "--set renderer.raymarch.msCache.layout=\\\"view\\\" --set renderer.raymarch.msCache.tile=4 "
+      "--set renderer.raymarch.msCache.filter=0 ";
   RunResult r =
       run("render s.json -o v.exr --stats-json v.json " + cache + "--set renderer.raymarch.msCache.guide=0.25");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   EXPECT_EQ(stats("v.json")["ms_cache_guide"], 0.25);
-  EXPECT_NE(r.out.find("\nmultiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, guided towards "
+  EXPECT_NE(r.out.find("multiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, guided towards "
                        "the lights (share 0.25) in "),
             std::string::npos)
       << r.out;
@@ -380,7 +393,7 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.msCache.layout: unknown value \"froxels\" (allowed: grid, view)\n"},
       {"renderer.raymarch.shadowWeighting=\\\"cosine\\\"",
        "narval: s.json: renderer.raymarch.shadowWeighting: unknown value \"cosine\" (allowed: area, phase)\n"},
-      {"renderer.raymarch.msCache.direct=true",
+      {"renderer.raymarch.msCache.direct=true --set renderer.raymarch.msCache.layout=\\\"grid\\\"",
        "narval: s.json: renderer.raymarch.msCache.direct: needs closure \"camera\" or layout \"view\" (a node must "
        "hold the light scattered towards the camera)\n"},
       {"renderer.raymarch.msCache.guide=-0.1",
@@ -388,10 +401,15 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
       {"renderer.raymarch.msCache.guide=1 --set renderer.raymarch.msCache.layout=\\\"view\\\"",
        "narval: s.json: renderer.raymarch.msCache.guide: must be below 1 (the phase function's share covers every "
        "direction), got 1\n"},
-      {"renderer.raymarch.msCache.guide=0.15",
+      {"renderer.raymarch.msCache.guide=0.15 --set renderer.raymarch.msCache.layout=\\\"grid\\\" "
+       "--set renderer.raymarch.msCache.direct=false",
        "narval: s.json: renderer.raymarch.msCache.guide: needs closure \"camera\" or layout \"view\" (the uniform "
        "closures draw no phase-function directions to guide)\n"},
       {"renderer.raymarch.msCache.tile=0", "narval: s.json: renderer.raymarch.msCache.tile: must be at least 1, got 0\n"},
+      {"renderer.raymarch.msCache.tile=\\\"big\\\"",
+       "narval: s.json: renderer.raymarch.msCache.tile: expected \"auto\" or pixels per column side, got \"big\"\n"},
+      {"renderer.raymarch.quality=\\\"ultra\\\"",
+       "narval: s.json: renderer.raymarch.quality: unknown value \"ultra\" (allowed: draft, interactive, high)\n"},
       {"renderer.raymarch.msCache.slices=1",
        "narval: s.json: renderer.raymarch.msCache.slices: must be at least 2, got 1\n"},
       {"renderer.raymarch.msCache.filter=-1",
@@ -400,7 +418,7 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.msCache.filter: must be at most 8 (columns), got 9\n"},
       {"renderer.raymarch.msCache.filterTolerance=0",
        "narval: s.json: renderer.raymarch.msCache.filterTolerance: must be positive, got 0\n"},
-      {"renderer.raymarch.msCache.filterTwicing=true --set renderer.raymarch.msCache.layout=\\\"view\\\"",
+      {"renderer.raymarch.msCache.filterTwicing=true --set renderer.raymarch.msCache.filter=0",
        "narval: s.json: renderer.raymarch.msCache.filterTwicing: needs filter > 0 (it filters the filter's "
        "residual)\n"},
       {"renderer.raymarch.msCache.filterTwicing=1",

@@ -27,11 +27,11 @@ class ViewCli : public CliFixture {
   void SetUp() override {
     ASSERT_EQ(std::system("command -v xvfb-run > /dev/null"), 0)
         << "xvfb-run is missing: scripts/setup.sh installs xvfb (the viewer's tests need a display)";
-    // The fog scene as the ray marcher with its multiple-scattering cache, 64 paths a node.
+    // The fog scene as the ray marcher with a multiple-scattering cache of the grid layout, 64 paths a node.
     nlohmann::json scene = nlohmann::json::parse(fogSceneJson(64, 48, 12));
     scene["renderer"]["algorithm"] = "raymarch";
     scene["renderer"]["raymarch"] = {{"multipleScattering", "cache"},
-                                     {"msCache", {{"resolution", 4}, {"paths", 64}, {"pathsPerLaunch", 16}}}};
+                                     {"msCache", {{"layout", "grid"}, {"resolution", 4}, {"paths", 64}, {"pathsPerLaunch", 16}}}};
     write("fog.json", scene.dump(2));
   }
   nlohmann::json stats(const std::string& name) { return nlohmann::json::parse(readFile(dir_ / name)); }

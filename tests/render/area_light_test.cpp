@@ -228,7 +228,7 @@ TEST(RenderAreaLight, RaymarchExactPhaseMatchesQuadrature) {
   const SlabParams P;
   auto scene = [](const std::string& phase) {
     return lightSlabScene(R"({"resolution": [16, 16], "algorithm": "raymarch", "bounces": 1, "lightCache": {"resolution": 0},
-                         "raymarch": {"steps": 128, "shadowSteps": 16, "shadowAreaSamples": 8, "minTransmittance": 0, )" +
+                         "raymarch": {"multipleScattering": "none", "steps": 128, "shadowSteps": 16, "shadowAreaSamples": 8, "minTransmittance": 0, )" +
                      phase + "}}");
   };
   const Scene exact = scene(R"("areaLightPhase": "exact")");

@@ -41,7 +41,8 @@ std::string cloudScene(const std::string& algorithm) {
     {"name": "box", "type": "volume", "transform": {"scale": [3, 3, 3], "rotation": [0, 15, 0]}, "materialName": "cloud"}
   ],
   "camera": {"position": [0, 0, -7], "lookAt": [0, 0, 0], "up": [0, 1, 0], "vfov": 35},
-  "renderer": {"resolution": [24, 18], "spp": 8, "bounces": 4, "seed": 5, "algorithm": ")" + algorithm + R"("},
+  "renderer": {"resolution": [24, 18], "spp": 8, "bounces": 4, "seed": 5, "algorithm": ")" + algorithm +
+         (algorithm == "raymarch" ? R"(", "raymarch": {"multipleScattering": "none"}},)" : R"("},)") + R"(
   "background": [0.1, 0.1, 0.2]
 })";
 }

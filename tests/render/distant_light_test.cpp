@@ -94,7 +94,7 @@ TEST(DistantLight, RayMarchedSlabMatchesSingleScatteringPerPixel) {
   for (const char* cache : {"0", "\"auto\""}) {
     SCOPED_TRACE(std::string("lightCache.resolution ") + cache);
     const Scene scene = sceneFromJson(slabJson(
-        0.0, std::string(R"({"resolution": [16, 16], "algorithm": "raymarch", "raymarch": {"steps": 256}, "lightCache": {"resolution": )") +
+        0.0, std::string(R"({"resolution": [16, 16], "algorithm": "raymarch", "raymarch": {"multipleScattering": "none", "steps": 256}, "lightCache": {"resolution": )") +
                  cache + "}}"));
     const RenderResult r = renderAlgorithm(scene);
     ASSERT_EQ(r.stats.status, 0u);

@@ -43,9 +43,10 @@ namespace {
 constexpr double kRelTolerance = 1e-4;
 constexpr double kScaleTolerance = 1e-5;
 
+// The ray marcher as the dissertation's single-scattering march (the cache's storage: ms_cache_test.cpp).
 std::string cloudScene(const std::string& algorithm) {
   return litCloudJson(R"({"resolution": [40, 30], "spp": 16, "bounces": 6, "seed": 5, "algorithm": ")" + algorithm +
-                      R"("})");
+                      (algorithm == "raymarch" ? R"(", "raymarch": {"multipleScattering": "none"}})" : R"("})"));
 }
 
 // The scene rendered in each storage; both runs clean.
@@ -200,6 +201,7 @@ TEST(GridStorage, DisneyCloudSamePixelsEveryAlgorithm) {
   for (const char* algorithm : {"pathtrace", "raymarch", "lobe"}) {
     Scene s = sceneFromJson(listing41Json(path));
     ASSERT_TRUE(algorithmFromName(algorithm, &s.renderer.algorithm));
+    s.renderer.raymarch.multipleScattering = MultipleScattering::None;  // the dissertation's march
     s.renderer.width = 48;
     s.renderer.height = 24;
     s.renderer.spp = 8;

@@ -71,7 +71,7 @@ TEST(LightCacheRender, ErrorAgainstExactMarchingFallsWithResolutionWithinTheDeri
     const char* params;
     double dMin;
   } kernels[] = {
-      {"raymarch", R"("raymarch": {"steps": 40, "shadowSteps": 10, "minTransmittance": 0})", 2.5},
+      {"raymarch", R"("raymarch": {"multipleScattering": "none", "steps": 40, "shadowSteps": 10, "minTransmittance": 0})", 2.5},
       {"lobe", R"("lobe": {"lobePoints": 8, "depthFactor": 0.5, "lobeRadius": 0.2, "shadowSteps": 10, "minTransmittance": 0})",
        2.3},
   };
@@ -110,7 +110,7 @@ TEST(LightCacheRender, AutomaticCacheOnACloudStaysWithinOneDeltaEOfExactMarching
   for (const char* algorithm : {"raymarch", "lobe"}) {
     auto renderer = [&](const char* cache) {
       return R"({"resolution": [120, 90], "algorithm": ")" + std::string(algorithm) + R"(", "storage": "buffer",
-                 "lightCache": {"resolution": )" + cache + "}}";
+                 "raymarch": {"multipleScattering": "none"}, "lightCache": {"resolution": )" + cache + "}}";
     };
     const RenderResult exact = renderAlgorithm(sceneFromJson(litCloudJson(renderer("0"))), &cloud);
     const RenderResult cached = renderAlgorithm(sceneFromJson(litCloudJson(renderer("\"auto\""))), &cloud);
@@ -133,7 +133,7 @@ TEST(LightCacheRender, DeviceBuildMatchesTheHost) {
     const DenseGrid cloud = makeCloud(24, 5);
     const Scene scene = sceneFromJson(litCloudJson(R"({"resolution": [8, 8], "algorithm": "raymarch", "storage": "buffer",
                                                        "lightCache": {"resolution": 20},
-                                                       "raymarch": {"shadowWeighting": ")" + std::string(weighting) + R"("}})"));
+                                                       "raymarch": {"multipleScattering": "none", "shadowWeighting": ")" + std::string(weighting) + R"("}})"));
     DeviceSceneBuffers dev(runtime(), scene, &cloud);
     const RealtimeParams params = realtimeParams(scene, dev.scene);
     EXPECT_EQ(params.march.shadow_weighting, std::string(weighting) == "phase" ? SHADOW_WEIGHTING_PHASE : SHADOW_WEIGHTING_AREA);
@@ -160,7 +160,8 @@ TEST(LightCacheRender, DeviceBuildMatchesTheHost) {
 TEST(LightCacheRender, ANanVoxelRaisesTheBuildsStatus) {
   DenseGrid g = makeCloud(16, 2);
   const Scene scene = sceneFromJson(litCloudJson(R"({"resolution": [8, 8], "algorithm": "raymarch", "storage": "buffer",
-                                                     "lightCache": {"resolution": 8}})"));
+                                                     "lightCache": {"resolution": 8},
+                                                     "raymarch": {"multipleScattering": "none"}})"));
   DeviceLightCache clean, poisoned;
   DeviceSceneBuffers devClean(runtime(), scene, &g);
   const RealtimeParams params = realtimeParams(scene, devClean.scene);
@@ -186,7 +187,8 @@ TEST(LightCacheRender, RebuildsOnlyTheSlabsWhoseInputsChanged) {
     json.replace(json.find("\"density\": 4}"), 13, "\"density\": " + std::to_string(density) + "}");
     return sceneFromJson(json);
   };
-  const std::string r = R"({"resolution": [8, 8], "algorithm": "raymarch", "storage": "buffer", "lightCache": {"resolution": 8}})";
+  const std::string r = R"({"resolution": [8, 8], "algorithm": "raymarch", "storage": "buffer", "lightCache": {"resolution": 8},
+                               "raymarch": {"multipleScattering": "none"}})";
   const Scene a = scene(r);
   DeviceLightCache cache;
   auto update = [&](const DeviceSceneBuffers& dev, const RealtimeParams& p, const std::string& file) {
@@ -249,7 +251,7 @@ TEST(LightCacheRender, EarlyTerminationChangesNoPixelBeyondItsBound) {
       const char* params;
       double bound;
     } kernels[] = {
-        {"raymarch", R"("raymarch": {"steps": 60, "shadowSteps": 10, "minTransmittance": %g})", epsPixel * std::max(A, Lb)},
+        {"raymarch", R"("raymarch": {"multipleScattering": "none", "steps": 60, "shadowSteps": 10, "minTransmittance": %g})", epsPixel * std::max(A, Lb)},
         {"lobe",
          R"("lobe": {"lobePoints": 8, "depthFactor": 4, "lobeRadius": 0.2, "viewSteps": 40, "minTransmittance": %g})",
          epsPixel * Lb},

@@ -563,11 +563,17 @@ LitBoxCheck checkLitBox(const std::string& phase, const std::string& coarseCache
     return s;
   };
   const std::string pt = R"({"resolution": [16, 16], "spp": 16384, "bounces": 64})";
+  // The cases name what they differ in from the settings these bounds were derived for: the grid
+  // layout, and neither the direct light nor the view layout's filter (the loader's defaults hold both).
   auto rm = [](int steps, const std::string& ms, const std::string& cache, int paths) {
+    const bool view = cache.find(R"("view")") != std::string::npos;
+    const std::string unnamed = std::string(view ? "" : R"(, "layout": "grid")") +
+                                (cache.find(R"("direct")") == std::string::npos ? R"(, "direct": false)" : "") +
+                                (view && cache.find(R"("filter")") == std::string::npos ? R"(, "filter": 0)" : "");
     return R"({"resolution": [16, 16], "bounces": 64, "algorithm": "raymarch", "lightCache": {"resolution": 0},
       "raymarch": {"steps": )" + std::to_string(steps) + R"(, "shadowSteps": 4, "minTransmittance": 0,
       "multipleScattering": ")" + ms + R"(", "msCache": {"paths": )" + std::to_string(paths) +
-           R"(, "pathsPerLaunch": 512, )" + cache + "}}}";
+           R"(, "pathsPerLaunch": 512, )" + cache + unnamed + "}}}";
   };
   const RenderResult ptA = render(scene(pt, 1), grid), ptB = render(scene(pt, 2), grid);
   LitBoxCheck out;

@@ -25,6 +25,8 @@ constexpr double kPi = 3.14159265358979323846;
 // cache and early termination are off here (their bounds: light_cache_render_test.cpp).
 RenderResult raymarch(Scene scene, const DenseGrid* grid = nullptr, int lx = 8, int ly = 8) {
   scene.renderer.algorithm = Algorithm::Raymarch;
+  if (scene.renderer.raymarch.multipleScattering == MultipleScattering::Cache)  // the dissertation's march
+    scene.renderer.raymarch.multipleScattering = MultipleScattering::None;
   scene.renderer.lightCache.resolution = 0;
   scene.renderer.raymarch.minTransmittance = 0;
   RenderOptions o;

@@ -34,7 +34,7 @@ struct GoldenCase {
 const GoldenCase kCases[] = {
     {"raymarch_grid",
      R"({"resolution": [32, 24], "algorithm": "raymarch", "storage": "buffer", "lightCache": {"resolution": 0},
-         "raymarch": {"steps": 60, "shadowSteps": 10, "minTransmittance": 0, "shadowAreaSamples": 1}})",
+         "raymarch": {"multipleScattering": "none", "steps": 60, "shadowSteps": 10, "minTransmittance": 0, "shadowAreaSamples": 1}})",
      true},
     {"raymarch_octaves_grid",
      R"({"resolution": [32, 24], "algorithm": "raymarch", "storage": "buffer", "lightCache": {"resolution": 0},
@@ -42,7 +42,7 @@ const GoldenCase kCases[] = {
      true},
     {"raymarch_homogeneous",
      R"({"resolution": [32, 24], "algorithm": "raymarch", "lightCache": {"resolution": 0},
-         "raymarch": {"steps": 30, "shadowSteps": 8, "minTransmittance": 0, "shadowAreaSamples": 1}})",
+         "raymarch": {"multipleScattering": "none", "steps": 30, "shadowSteps": 8, "minTransmittance": 0, "shadowAreaSamples": 1}})",
      false},
     {"lobe_grid",
      R"({"resolution": [32, 24], "algorithm": "lobe", "storage": "buffer", "lightCache": {"resolution": 0},

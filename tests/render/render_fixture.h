@@ -39,7 +39,7 @@ inline Scene litBox() {
     ],
     "camera": {"position": [0, 0, -4], "lookAt": [0, 0, 0], "vfov": 30},
     "renderer": {"resolution": [8, 8], "algorithm": "raymarch", "bounces": 20,
-                 "raymarch": {"multipleScattering": "cache", "msCache": {"resolution": 4}}},
+                 "raymarch": {"multipleScattering": "cache", "msCache": {"layout": "grid", "resolution": 4}}},
     "background": [0.2, 0.2, 0.2]
   })");
 }
@@ -72,7 +72,7 @@ inline RenderResult renderAlgorithm(const Scene& scene, SceneGrids grid = {}) {
 }
 
 // What the hard-case suites render: every algorithm and every real-time option: the ray marcher
-// with octaves (and 2x2 phase points per rectangle light), with its multiple-scattering cache
+// as the dissertation's single-scattering march ("raymarch"), with octaves (and 2x2 phase points per rectangle light), with its multiple-scattering cache
 // ("raymarch+ms-cache": a small one, 4 cells and 8 paths per node, so the suites stay fast; every
 // code path of the cache's build and lookup runs; with the phase integrated exactly over rectangle
 // lights and the HG closure; "raymarch+ms-cache-camera" the same cache with its paths aimed at the
@@ -93,6 +93,8 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGr
       renderer == "raymarch+ms-cache-direct") {
     scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
+    scene.renderer.raymarch.msCache.layout = MsCacheLayout::Grid;
+    scene.renderer.raymarch.msCache.direct = false;
     scene.renderer.raymarch.msCache.resolution = 4;
     scene.renderer.raymarch.msCache.paths = 8;
     scene.renderer.raymarch.areaLightPhase = AreaLightPhase::Exact;  // the phase over a rectangle's solid angle
@@ -107,6 +109,9 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGr
       scene.renderer.raymarch.msCache.direct = renderer == "raymarch+ms-cache-direct";
       if (renderer == "raymarch+ms-cache-direct") scene.renderer.raymarch.msCache.allocation = MsCacheAllocationKind::Perceptual;
     }
+  } else if (renderer == "raymarch") {  // the dissertation's march: single scattering
+    scene.renderer.algorithm = Algorithm::Raymarch;
+    scene.renderer.raymarch.multipleScattering = MultipleScattering::None;
   } else if (renderer == "raymarch+octaves") {
     scene.renderer.algorithm = Algorithm::Raymarch;
     scene.renderer.raymarch.multipleScattering = MultipleScattering::Octaves;

@@ -177,7 +177,16 @@ TEST(SceneDefaults, OptionalKeysTakeTheDocumentedDefaults) {
   EXPECT_EQ(r.exposure, 0.0f);
   EXPECT_EQ(r.algorithm, Algorithm::Pathtrace);
   EXPECT_EQ(r.seed, 0u);
-  EXPECT_EQ(r.raymarch.steps, 60);
+  // The ray marcher draws multiple scattering by default: the view cache at the interactive quality
+  // (30 steps, 100 paths a node, the tile chosen at render time).
+  EXPECT_EQ(r.raymarch.multipleScattering, MultipleScattering::Cache);
+  EXPECT_EQ(r.raymarch.quality, RaymarchQuality::Interactive);
+  EXPECT_EQ(r.raymarch.steps, 30);
+  EXPECT_EQ(r.raymarch.msCache.layout, MsCacheLayout::View);
+  EXPECT_EQ(r.raymarch.msCache.tile, kMsCacheTileAuto);
+  EXPECT_EQ(r.raymarch.msCache.paths, 100);
+  EXPECT_TRUE(r.raymarch.msCache.direct);
+  EXPECT_EQ(r.raymarch.msCache.filter, 1.5f);
   EXPECT_EQ(r.raymarch.shadowSteps, 10);
   EXPECT_EQ(r.lobe.depthFactor, 20.0f);
   EXPECT_EQ(r.lobe.lobePoints, 30);
@@ -444,7 +453,7 @@ TEST(SceneErrors, NearMissKeysNameTheKeyTheyProbablyMeant) {
 TEST(SceneWarnings, MsCacheSettingsWithoutTheCache) {
   json j = minimalScene();
   j["renderer"]["algorithm"] = "raymarch";
-  j["renderer"]["raymarch"] = {{"msCache", {{"paths", 64}}}};
+  j["renderer"]["raymarch"] = {{"multipleScattering", "none"}, {"msCache", {{"paths", 64}}}};
   EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
             (std::vector<std::string>{"s.json: renderer.raymarch.msCache: applies to multipleScattering \"cache\"; "
                                       "\"none\" ignores it"}));
@@ -581,7 +590,7 @@ TEST(SceneWarnings, EqSevenKeysUnderTheCorrectedLobe) {
 // at its defaults (as a resolved scene writes every one) is not.
 TEST(SceneWarnings, SectionsTheAlgorithmDoesNotRead) {
   json j = minimalScene();  // the path tracer
-  j["renderer"]["raymarch"] = {{"steps", 30}};
+  j["renderer"]["raymarch"] = {{"steps", 45}};
   j["renderer"]["lobe"] = {{"lobePoints", 30}};  // its default
   j["renderer"]["lightCache"] = {{"resolution", 32}};
   EXPECT_EQ(parseScene(j.dump(), "s.json").warnings,
@@ -618,7 +627,8 @@ TEST(SceneResolved, ReadsBackToTheSameDocumentAndRenderKey) {
   EXPECT_EQ(r["renderer"]["spp"], 1000);
   EXPECT_EQ(r["renderer"]["lobe"]["viewSteps"], 16);  // the corrected variant's default
   EXPECT_EQ(r["renderer"]["lobe"]["shadowAreaSamples"], 4);
-  EXPECT_EQ(r["renderer"]["raymarch"]["msCache"]["paths"], 256);
+  EXPECT_EQ(r["renderer"]["raymarch"]["msCache"]["paths"], 100);  // the interactive quality's
+  EXPECT_EQ(r["renderer"]["raymarch"]["msCache"]["tile"], "auto");
   EXPECT_EQ(r["renderer"]["lightCache"]["resolution"], "auto");
   EXPECT_EQ(r["renderer"]["toneMapping"], "aces");
   EXPECT_EQ(r["renderer"]["pathtrace"]["shadowRoulette"], 0.05);  // the float's shortest decimal
