@@ -69,21 +69,27 @@ TEST(MsCache, WhiteFurnaceIsOneWithTheCacheAndNotWithout) {
     // every node of either holds exactly 1, and a view lookup renormalises over the columns that
     // hold medium, so every pixel whose ray meets density reads 1 as well; so does the view
     // layout's filter (ms_cache_filter.h: normalised weights of reads that are all 1).
-    for (const std::string layout : {R"("layout": "grid", "resolution": 4)", R"("layout": "view", "tile": 4)",
-                                     R"("layout": "view", "tile": 4, "filter": 1.5)"}) {
+    // And the loader's defaults (the view layout holding the direct light, filtered; tile auto, a
+    // column a pixel at 16x16 on a CPU).
+    for (const std::string layout : {R"("layout": "grid", "resolution": 4)", R"("layout": "view", "tile": 4, "filter": 0)",
+                                     R"("layout": "view", "tile": 4, "filter": 1.5)", R"("tile": "auto")"}) {
       SCOPED_TRACE(layout);
       const RenderResult cached =
           renderRealtime(runtime(), sceneFromJson(furnaceJson("cache", density, layout)), grid, 3, {});
       ASSERT_EQ(cached.stats.status, 0u);
       EXPECT_EQ(cached.stats.msCache.paths, 8);
       EXPECT_EQ(cached.stats.msCache.builds, 1);  // built once for three frames
-      EXPECT_EQ(cached.stats.msCache.cells[0], 4);
+      EXPECT_EQ(cached.stats.msCache.cells[0], layout.find("auto") != std::string::npos ? 16 : 4);
       EXPECT_EQ(cached.stats.msCache.cells[2], cached.stats.msCache.view ? 8 : 4);
       double worst = 0;
       for (float v : cached.image.rgb) worst = std::max(worst, std::fabs(v - 1.0));
-      const bool filtered = layout.find("filter") != std::string::npos;
+      const bool filtered = cached.stats.msCache.filter > 0;
       std::printf("[ ms cache ] furnace (%s, %s): max |L - 1| %.2g with the cache\n", name,
-                  !cached.stats.msCache.view ? "grid" : filtered ? "view, filtered" : "view", worst);
+                  layout.find("auto") != std::string::npos ? "defaults"
+                  : !cached.stats.msCache.view             ? "grid"
+                  : filtered                               ? "view, filtered"
+                                                           : "view",
+                  worst);
       EXPECT_LE(worst, 1e-5);
     }
 
@@ -329,6 +335,7 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   Scene scene = litBox();
   scene.renderer.raymarch.msCache.layout = MsCacheLayout::View;
   scene.renderer.raymarch.msCache.tile = 1;
+  scene.renderer.raymarch.msCache.filter = 0;
   const std::vector<float> plain = cacheAfter(scene, 48, 16);
   scene.renderer.raymarch.msCache.filter = 1.5f;
   scene.renderer.raymarch.msCache.filterTolerance = 2.0f;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "render/realtime_params.h"
 #include "render/scene_upload.h"
 #include "scene/scene.h"
 #include "shared/ms_cache_view.h"
@@ -37,6 +38,38 @@ ms_cache_params viewParams(int nx, int ny, int nz, int tile) {
   mc.layout = MS_CACHE_LAYOUT_VIEW;
   mc.tile = tile;
   return mc;
+}
+
+// msCache.tile "auto" (realtime_params.h): a column a pixel on a GPU; on a CPU the smallest side t
+// with W·H/t² at most the quality's columns (draft 160·120 = 19,200, interactive 76,800, high
+// 307,200); an explicit tile wins everywhere.
+TEST(MsCacheView, AnAutomaticTileIsAPixelOnGpusAndBoundsTheColumnsOnCpus) {
+  RaymarchSettings r;
+  ASSERT_EQ(r.msCache.tile, kMsCacheTileAuto);
+  const struct {
+    RaymarchQuality quality;
+    double width, height;
+    int cpuTile;
+  } cases[] = {
+      {RaymarchQuality::Interactive, 320, 240, 1},    // 76,800 columns: the bound itself
+      {RaymarchQuality::Interactive, 321, 240, 2},    // one column over: 77,040 / 4
+      {RaymarchQuality::Interactive, 640, 360, 2},    // 57,600
+      {RaymarchQuality::Interactive, 1280, 720, 4},   // 57,600
+      {RaymarchQuality::Interactive, 1920, 1080, 6},  // 2,073,600 / 25 = 82,944 > 76,800; / 36 = 57,600
+      {RaymarchQuality::Draft, 320, 240, 2},          // 19,200
+      {RaymarchQuality::High, 640, 480, 1},
+      {RaymarchQuality::High, 1280, 720, 2},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(std::to_string(int(c.width)) + "x" + std::to_string(int(c.height)));
+    r.quality = c.quality;
+    r.msCache.tile = kMsCacheTileAuto;
+    EXPECT_EQ(msCacheTile(r, c.width * c.height, false), c.cpuTile);
+    EXPECT_EQ(msCacheTile(r, c.width * c.height, true), 1);
+    r.msCache.tile = 3;
+    EXPECT_EQ(msCacheTile(r, c.width * c.height, false), 3);
+    EXPECT_EQ(msCacheTile(r, c.width * c.height, true), 3);
+  }
 }
 
 // A pixel at its column's centre reads that column alone; one between column centres reads them
