@@ -554,16 +554,27 @@ ImageRGB averaged(const ImageRGB& a, const ImageRGB& b) {
 // one: the fine cache has 8 times the nodes (twice the columns each way and twice the slices; 17³
 // against 9³ corners in the grid layout), so a tile's mean holds twice the coarse cache's paths and
 // var_cache(2N) is about half of var_cache(N); the bound's noise term is then at most
-// sqrt(1.5/1.125) = 1.15 times what 2048 fine paths give, at a quarter of their cost.
+// sqrt(1.5/1.125) = 1.15 times what 2048 fine paths give, at a quarter of their cost. Cases of the
+// same box, phase function and light share one path-traced reference and one other renderer: each
+// is rendered once.
+struct LitBoxCase {
+  const char* what;          // printed with the case's figures
+  std::string coarse, fine;  // msCache keys
+  double widestBound;        // asserted: the bound's widest share of a tile's value
+};
+
 struct LitBoxCheck {
   double worstRatio = 0, worstBound = 0, otherOutside = 0;
   size_t tiles = 0;
   int budgetMin = 0, budgetMax = 0;  // the coarse cache's perceptual allocation, seed 1 (0, 0: even)
 };
 
-LitBoxCheck checkLitBox(const std::string& phase, const std::string& coarseCache, const std::string& fineCache,
-                        const std::string& otherMs, const std::string& otherCache,
-                        const std::string& light = kLitBoxBulb, SceneGrids grid = {}) {
+// Checks every case against the shared reference, printing what each measured and asserting its
+// widest bound and that the other renderer is outside the bound on at least otherShare of the tile
+// channels (a bound that can tell).
+std::vector<LitBoxCheck> checkLitBox(const std::string& phase, const std::vector<LitBoxCase>& cases,
+                                     const std::string& otherMs, const std::string& otherCache, const char* otherName,
+                                     double otherShare, const std::string& light = kLitBoxBulb, SceneGrids grid = {}) {
   auto scene = [&](const std::string& renderer, uint32_t seed) {
     Scene s = sceneFromJson(litBoxJson(renderer, phase, light));
     s.renderer.seed = seed;
@@ -582,51 +593,47 @@ LitBoxCheck checkLitBox(const std::string& phase, const std::string& coarseCache
       "multipleScattering": ")" + ms + R"(", "msCache": {"paths": )" + std::to_string(paths) +
            R"(, "pathsPerLaunch": 512, )" + cache + unnamed + "}}}";
   };
-  const RenderResult ptA = render(scene(pt, 1), grid), ptB = render(scene(pt, 2), grid);
-  LitBoxCheck out;
-  auto realtime = [&](const std::string& renderer, uint32_t seed) {
+  auto realtime = [&](const std::string& renderer, uint32_t seed, LitBoxCheck* allocation = nullptr) {
     const RenderResult r = renderRealtime(runtime(), scene(renderer, seed), grid, 1, RenderOptions{});
     EXPECT_EQ(r.stats.status, 0u);
-    if (out.budgetMax == 0) out.budgetMin = r.stats.msCache.budgetMin, out.budgetMax = r.stats.msCache.budgetMax;
+    if (allocation) allocation->budgetMin = r.stats.msCache.budgetMin, allocation->budgetMax = r.stats.msCache.budgetMax;
     return r.image;
   };
-  const ImageRGB coarseA = realtime(rm(64, "cache", coarseCache, 2048), 1),
-                 coarseB = realtime(rm(64, "cache", coarseCache, 2048), 2);
-  const ImageRGB fineA = realtime(rm(128, "cache", fineCache, 512), 1),
-                 fineB = realtime(rm(128, "cache", fineCache, 512), 2);
-  const ImageRGB other = realtime(rm(64, otherMs, otherCache, 2048), 1);
+  const RenderResult ptA = render(scene(pt, 1), grid), ptB = render(scene(pt, 2), grid);
   EXPECT_EQ(ptA.stats.status, 0u);
-
   const std::vector<double> ref = tileMeans(averaged(ptA.image, ptB.image));
-  const std::vector<double> coarse = tileMeans(averaged(coarseA, coarseB));
-  const std::vector<double> fine = tileMeans(averaged(fineA, fineB));
-  const std::vector<double> otherMeans = tileMeans(other);
   const std::vector<double> varPt = tileVarianceOfMean(ptA.image, ptB.image);
-  const std::vector<double> varCoarse = tileVarianceOfMean(coarseA, coarseB);
-  const std::vector<double> varFine = tileVarianceOfMean(fineA, fineB);
-  out.tiles = ref.size();
-  for (size_t i = 0; i < ref.size(); ++i) {
-    const double bound =
-        4 * std::sqrt(varPt[i] + varCoarse[i] + varFine[i]) + 4.0 / 3.0 * std::fabs(coarse[i] - fine[i]);
-    const double error = std::fabs(coarse[i] - ref[i]);
-    EXPECT_LE(error, bound) << "tile " << i / 3 << " channel " << i % 3 << ": path tracer " << ref[i]
-                            << ", ray marcher + cache " << coarse[i];
-    out.worstRatio = std::max(out.worstRatio, error / bound);
-    if (ref[i] > 1e-3) out.worstBound = std::max(out.worstBound, bound / ref[i]);
-    if (std::fabs(otherMeans[i] - ref[i]) > bound) out.otherOutside += 1;
+  const std::vector<double> otherMeans = tileMeans(realtime(rm(64, otherMs, otherCache, 2048), 1));
+  std::vector<LitBoxCheck> checks;
+  for (const LitBoxCase& c : cases) {
+    SCOPED_TRACE(c.what);
+    LitBoxCheck out;
+    const ImageRGB coarseA = realtime(rm(64, "cache", c.coarse, 2048), 1, &out),
+                   coarseB = realtime(rm(64, "cache", c.coarse, 2048), 2);
+    const ImageRGB fineA = realtime(rm(128, "cache", c.fine, 512), 1), fineB = realtime(rm(128, "cache", c.fine, 512), 2);
+    const std::vector<double> coarse = tileMeans(averaged(coarseA, coarseB));
+    const std::vector<double> fine = tileMeans(averaged(fineA, fineB));
+    const std::vector<double> varCoarse = tileVarianceOfMean(coarseA, coarseB);
+    const std::vector<double> varFine = tileVarianceOfMean(fineA, fineB);
+    out.tiles = ref.size();
+    for (size_t i = 0; i < ref.size(); ++i) {
+      const double bound =
+          4 * std::sqrt(varPt[i] + varCoarse[i] + varFine[i]) + 4.0 / 3.0 * std::fabs(coarse[i] - fine[i]);
+      const double error = std::fabs(coarse[i] - ref[i]);
+      EXPECT_LE(error, bound) << "tile " << i / 3 << " channel " << i % 3 << ": path tracer " << ref[i]
+                              << ", ray marcher + cache " << coarse[i];
+      out.worstRatio = std::max(out.worstRatio, error / bound);
+      if (ref[i] > 1e-3) out.worstBound = std::max(out.worstBound, bound / ref[i]);
+      if (std::fabs(otherMeans[i] - ref[i]) > bound) out.otherOutside += 1;
+    }
+    std::printf("[ ms cache ] lit box, %s: worst |error|/bound %.2f, widest bound %.2f%% of the value, %s outside "
+                "the bound on %.0f of %zu tile channels\n",
+                c.what, out.worstRatio, 100 * out.worstBound, otherName, out.otherOutside, out.tiles);
+    EXPECT_LE(out.worstBound, c.widestBound);
+    EXPECT_GE(out.otherOutside, otherShare * double(out.tiles));
+    checks.push_back(out);
   }
-  return out;
-}
-
-// Prints what checkLitBox measured (`what`: the test's case; `other`: what the other renderer is)
-// and asserts the bound's widest share of the value and the share of tile channels the other
-// renderer leaves outside it.
-void expectLitBox(const LitBoxCheck& c, const char* what, const char* other, double widestBound, double otherShare) {
-  std::printf("[ ms cache ] lit box, %s: worst |error|/bound %.2f, widest bound %.2f%% of the value, %s outside the "
-              "bound on %.0f of %zu tile channels\n",
-              what, c.worstRatio, 100 * c.worstBound, other, c.otherOutside, c.tiles);
-  EXPECT_LE(c.worstBound, widestBound);
-  EXPECT_GE(c.otherOutside, otherShare * double(c.tiles));
+  return checks;
 }
 
 // With an isotropic phase function the in-scattered radiance at a point is the directional average
@@ -647,62 +654,77 @@ void expectLitBox(const LitBoxCheck& c, const char* what, const char* other, dou
 // alone (no cache) is outside it nearly everywhere. Cells 8 → 16, steps 64 → 128; 2048 and 512 paths
 // per node, 2 × 16384 spp for the path tracer.
 TEST(MsCache, IsotropicLitBoxMatchesThePathTracer) {
-  const LitBoxCheck c = checkLitBox(R"("phaseFunction": "isotropic")", R"("resolution": 8)", R"("resolution": 16)",
-                                    "none", R"("resolution": 8)");
-  expectLitBox(c, "isotropic", "single scattering alone", 0.06, 0.9);
+  checkLitBox(R"("phaseFunction": "isotropic")", {{"isotropic", R"("resolution": 8)", R"("resolution": 16)", 0.06}},
+              "none", R"("resolution": 8)", "single scattering alone", 0.9);
 }
 
-// The closure "camera" draws each node's path directions from the phase function about the
-// direction from the node to the camera, so a node holds the in-scattering towards the camera
-// itself (ms_cache.h, "Closure"): for any phase function what the isotropic test above holds for
-// the directional average. The sample's direction to the camera is its view ray's (a pinhole), so
-// the lookup interpolates the smooth field x ↦ ∫ p(w·w_c(x)) L(x, w) dw between nodes, second order
-// in the cell size as before, and the same bound applies. Here with HG g = 0.8, where the two
-// moments' linear closure is an approximation: the test asserts it falls outside the bound on most
-// tile channels (measured 39 of 48), so that the bound can tell. The bound is wider than the
-// isotropic one at the box's corners: there 8 cells read 11% low and 16 cells 3% (interpolation of
-// a forward-peaked field at the box's edge; noise is 5% of the value), so the widest bound is
-// 14.7% of the value (asserted ≤ 20%).
-TEST(MsCache, CameraClosureMatchesThePathTracerForAForwardPhaseFunction) {
-  const LitBoxCheck c = checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("resolution": 8, "closure": "camera")",
-                                    R"("resolution": 16, "closure": "camera")", "cache", R"("resolution": 8)");
-  expectLitBox(c, "HG 0.8, closure camera", "the linear closure", 0.2, 0.5);
+// The caches aimed at the camera, HG g = 0.8 and the point light, where the two moments' linear
+// closure is an approximation: each case asserts it falls outside the bound on most tile channels,
+// so that the bound can tell (measured 39, 42 and 42 of 48).
+// - The closure "camera" draws each node's path directions from the phase function about the
+//   direction from the node to the camera, so a node holds the in-scattering towards the camera
+//   itself (ms_cache.h, "Closure"): for any phase function what the isotropic test above holds for
+//   the directional average. The sample's direction to the camera is its view ray's (a pinhole), so
+//   the lookup interpolates the smooth field x ↦ ∫ p(w·w_c(x)) L(x, w) dw between nodes, second order
+//   in the cell size as before, and the same bound applies. It is wider than the isotropic one at the
+//   box's corners: there 8 cells read 11% low and 16 cells 3% (interpolation of a forward-peaked field
+//   at the box's edge; noise is 5% of the value), so the widest bound is 14.7% of the value (asserted
+//   ≤ 20%).
+// - The view layout (ms_cache_view.h) holds the same in-scattering as means over slices of each
+//   column's optical depth instead of values at a grid's corners. Its lookup is bilinear between
+//   columns (second order for a smooth field over the image) and integrates each column's
+//   piecewise-constant J over the march step's τ exactly: exact in τ for a pixel whose J(τ) is its
+//   column's (the weight e^{−τ}dτ does not depend on the geometry). Halving the tile and the slice
+//   width together (tile 2 → 1 pixel, 8 → 16 slices) shrinks what is left, and the Richardson bound is
+//   used unchanged. The widest bound, 16.2% of the value (asserted ≤ 25%), is at the darkest corner
+//   tile, where the noise of one-pixel columns is most of it.
+// - With msCache.direct the view layout's nodes hold the lights' unscattered light as well: each path
+//   makes the path tracer's next-event estimate at its start and counts the light its first segment
+//   meets under MIS (ms_cache.h, "Direct"), and the march adds no light loop; every scattering order
+//   then comes from the cache, and the same bound applies (the point light is met by the shadow rays
+//   alone; the rectangle, below, by both). Widest bound 16.8% (asserted ≤ 30%).
+TEST(MsCache, CameraAimedCachesMatchThePathTracerForAForwardPhaseFunction) {
+  checkLitBox(R"("phaseFunction": "hg", "g": 0.8)",
+              {{"HG 0.8, closure camera", R"("resolution": 8, "closure": "camera")",
+                R"("resolution": 16, "closure": "camera")", 0.2},
+               {"HG 0.8, layout view", R"("layout": "view", "tile": 2, "slices": 8)",
+                R"("layout": "view", "tile": 1, "slices": 16)", 0.25},
+               {"HG 0.8, point light, layout view with the direct light",
+                R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
+                R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", 0.3}},
+              "cache", R"("resolution": 8)", "the linear closure", 0.5);
 }
 
-// The view layout (ms_cache_view.h) holds the same in-scattering towards the camera as the closure
-// "camera", as means over slices of each column's optical depth instead of values at a grid's
-// corners. Its lookup is bilinear between columns (second order for a smooth field over the image)
-// and integrates each column's piecewise-constant J over the march step's τ exactly: exact in τ for
-// a pixel whose J(τ) is its column's (the weight e^{−τ}dτ does not depend on the geometry). Halving
-// the tile and the slice width together (tile 2 → 1 pixel, 8 → 16 slices) shrinks what is left,
-// and the isotropic test's Richardson bound is used unchanged. HG g = 0.8 as above, where the
-// linear closure falls outside it on most tile channels (measured 42 of 48). The widest bound,
-// 16.2% of the value (asserted ≤ 25%), is at the darkest corner tile, where the noise of one-pixel
-// columns is most of it.
-TEST(MsCache, ViewLayoutMatchesThePathTracerForAForwardPhaseFunction) {
-  const LitBoxCheck c = checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8)",
-                                    R"("layout": "view", "tile": 1, "slices": 16)", "cache", R"("resolution": 8)");
-  expectLitBox(c, "HG 0.8, layout view", "the linear closure", 0.25, 0.5);
-}
-
-// With msCache.direct the view layout's nodes hold the lights' unscattered light as well: each path
-// makes the path tracer's next-event estimate at its start and counts the light its first segment
-// meets under MIS (ms_cache.h, "Direct"), and the march adds no light loop. Every scattering order
-// then comes from the cache, and the same Richardson bound applies. Both kinds of light: a
-// rectangle (met by the first segments and by the shadow rays) and the point light (by the shadow
-// rays alone). The linear closure, whose single scattering the march computes, falls outside the
-// bound on most tile channels (measured 48 and 42 of 48), so the bound can tell. The widest bounds
-// are 14.0% and 16.8% of the value (asserted ≤ 30%).
-TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracer) {
-  const LitBoxCheck rect =
-      checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
-                  R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", "cache", R"("resolution": 8)",
-                  kLitBoxPanel);
-  expectLitBox(rect, "HG 0.8, rectangle light, layout view with the direct light", "the linear closure", 0.3, 0.5);
-  const LitBoxCheck point =
-      checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
-                  R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", "cache", R"("resolution": 8)");
-  expectLitBox(point, "HG 0.8, point light, layout view with the direct light", "the linear closure", 0.3, 0.5);
+// The view layout holding the direct light of a 1x1 rectangle light facing the box (met by the
+// paths' first segments and by the shadow rays, both weighted by MIS), HG g = 0.8; the linear
+// closure, whose single scattering the march computes, falls outside the bound on every tile
+// channel (measured 48 of 48). Three ways of spending the paths, each with the same expectation:
+// - evenly (widest bound 14.0%, asserted ≤ 30%);
+// - the perceptual allocation (render/ms_cache_allocation.h), which gives each column its own number
+//   of paths from its neighbours' pilot and never its own, so each node's mean keeps its expectation;
+//   its budgets are asserted to differ (measured 1280–2688 about the mean of 2048), so the allocation
+//   is in play;
+// - guided (msCache.guide, kernels/shared/phase_guide.h): half of each path's first directions drawn
+//   about the direction to the light instead of by the phase function, with the weight p/pdf and the
+//   mixture's pdf in both MIS weights, every weight in play. A share of 0.5, twice the picks', to make
+//   a wrong weight show.
+TEST(MsCache, ViewLayoutHoldingARectangleLightMatchesThePathTracerHoweverItSpendsItsPaths) {
+  const std::vector<LitBoxCheck> checks = checkLitBox(
+      R"("phaseFunction": "hg", "g": 0.8)",
+      {{"HG 0.8, rectangle light, layout view with the direct light",
+        R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
+        R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", 0.3},
+       {"HG 0.8, rectangle light, layout view with the direct light, allocated",
+        R"("layout": "view", "tile": 2, "slices": 8, "direct": true, "allocation": "perceptual")",
+        R"("layout": "view", "tile": 1, "slices": 16, "direct": true, "allocation": "perceptual")", 0.3},
+       {"HG 0.8, rectangle light, layout view with the direct light, guided",
+        R"("layout": "view", "tile": 2, "slices": 8, "direct": true, "guide": 0.5)",
+        R"("layout": "view", "tile": 1, "slices": 16, "direct": true, "guide": 0.5)", 0.3}},
+      "cache", R"("resolution": 8)", "the linear closure", 0.5, kLitBoxPanel);
+  ASSERT_EQ(checks.size(), 3u);
+  std::printf("[ ms cache ] lit box, allocated: budgets %d-%d paths a column\n", checks[1].budgetMin,
+              checks[1].budgetMax);
+  EXPECT_LT(checks[1].budgetMin, checks[1].budgetMax);
 }
 
 // The same in a heterogeneous medium: a 32³ grid filling the box whose density rises eightfold
@@ -716,7 +738,8 @@ TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracer) {
 // the path tracer's rays jittered over it. Measured on the generated cloud (makeCloud(32, 7)) in
 // this box: its four dimmest edge tiles read 0.22-0.70 of the path tracer's with one ray a pixel
 // (tile 1 or 2; 32 slices and 256 steps the same), 0.81-1.04 with 4x4 rays a pixel (a 64x64 frame
-// averaged down), whose footprint error the Richardson term does not see (bench/RESULTS.md).
+// averaged down), whose footprint error the Richardson term does not see (bench/RESULTS.md). The
+// linear closure is outside the bound on 27 of 48 tile channels here.
 TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracerInAHeterogeneousMedium) {
   DenseGrid ramp;
   ramp.nx = ramp.ny = ramp.nz = 32;
@@ -729,43 +752,11 @@ TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracerInAHeterogeneou
         ramp.data[size_t(x) + 32 * (size_t(y) + 32 * size_t(z))] = d;
         ramp.maxValue = std::max(ramp.maxValue, d);
       }
-  const LitBoxCheck rect =
-      checkLitBox(R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
-                  R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", "cache", R"("resolution": 8)",
-                  kLitBoxPanel, &ramp);
-  expectLitBox(rect, "HG 0.8, rectangle light, heterogeneous, layout view with the direct light", "the linear closure",
-               0.25, 0.5);
-}
-
-// The perceptual allocation (render/ms_cache_allocation.h) gives each column its own number of
-// paths, from its neighbours' pilot and never its own, so each node's mean keeps its expectation:
-// the same bound against the path tracer holds with the rectangle light. The coarse cache's budgets
-// are asserted to differ (measured: 1280–2688 about the mean of 2048), so the allocation is in play.
-TEST(MsCache, PerceptuallyAllocatedViewLayoutMatchesThePathTracer) {
-  const LitBoxCheck rect = checkLitBox(
-      R"("phaseFunction": "hg", "g": 0.8)",
-      R"("layout": "view", "tile": 2, "slices": 8, "direct": true, "allocation": "perceptual")",
-      R"("layout": "view", "tile": 1, "slices": 16, "direct": true, "allocation": "perceptual")", "cache",
-      R"("resolution": 8)", kLitBoxPanel);
-  expectLitBox(rect, "HG 0.8, rectangle light, layout view with the direct light, allocated", "the linear closure",
-               0.3, 0.5);
-  std::printf("[ ms cache ] lit box, allocated: budgets %d-%d paths a column\n", rect.budgetMin, rect.budgetMax);
-  EXPECT_LT(rect.budgetMin, rect.budgetMax);
-}
-
-// The guide (msCache.guide, kernels/shared/phase_guide.h) draws half of each path's first
-// directions about the direction to the light instead of by the phase function, with the weight
-// p/pdf and the mixture's pdf in both MIS weights (the next-event estimate at the node and the
-// rectangle its first segment meets): the same expectation, so the same bound against the path
-// tracer holds with the rectangle light, the case where every weight is in play. A share of 0.5,
-// twice the picks', to make a wrong weight show.
-TEST(MsCache, GuidedViewLayoutMatchesThePathTracer) {
-  const LitBoxCheck rect = checkLitBox(
-      R"("phaseFunction": "hg", "g": 0.8)", R"("layout": "view", "tile": 2, "slices": 8, "direct": true, "guide": 0.5)",
-      R"("layout": "view", "tile": 1, "slices": 16, "direct": true, "guide": 0.5)", "cache", R"("resolution": 8)",
-      kLitBoxPanel);
-  expectLitBox(rect, "HG 0.8, rectangle light, layout view with the direct light, guided", "the linear closure", 0.3,
-               0.5);
+  checkLitBox(R"("phaseFunction": "hg", "g": 0.8)",
+              {{"HG 0.8, rectangle light, heterogeneous, layout view with the direct light",
+                R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
+                R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", 0.25}},
+              "cache", R"("resolution": 8)", "the linear closure", 0.5, kLitBoxPanel, &ramp);
 }
 
 }  // namespace
