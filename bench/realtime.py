@@ -148,7 +148,8 @@ def tuning():
 
 def view_cache(tile, paths, sigma, tolerance, **more):
     """The view cache with the direct light and the filter (`more`: other msCache keys a pick names)."""
-    cache = dict(layout="view", direct=True, tile=tile, paths=paths, filter=sigma, filterTolerance=tolerance, **more)
+    cache = dict(dict(layout="view", direct=True, tile=tile, paths=paths, filter=sigma, filterTolerance=tolerance,
+                      filterTwicing=False), **more)
     return ["--algorithm", "raymarch", "--set", 'renderer.raymarch.multipleScattering="cache"',
             "--set", "renderer.raymarch.steps=30"] + [
         x for k, v in cache.items() for x in ("--set", "renderer.raymarch.msCache.%s=%s" % (k, json.dumps(v)))]

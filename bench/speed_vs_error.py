@@ -33,7 +33,8 @@ METHODS = {  # algorithm, fixed settings, base parameters that differ from what 
     "raymarch-cache-direct": ("raymarch", dict(VIEW, **{"msCache.direct": True}),
                               {"msCache.tile": 2, "msCache.paths": 256}),
     "raymarch-cache-filtered": ("raymarch", dict(VIEW, **{"msCache.direct": True, "msCache.tile": 1}),
-                                {"msCache.paths": 160, "msCache.filter": 1, "msCache.filterTolerance": 2}),
+                                {"msCache.paths": 160, "msCache.filter": 1, "msCache.filterTolerance": 2,
+                                 "msCache.filterTwicing": False}),
     "lobe-eq7": ("lobe", {"variant": "eq7"}, {}),
     "lobe-corrected": ("lobe", {"variant": "corrected"}, {}),
 }

@@ -147,7 +147,7 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   mc.noteRange("filterTolerance", "> 0");
   if (!(s.filterTolerance > 0))
     ctx.fail(mc.keyOf("filterTolerance"), "must be positive, got " + formatNumber(s.filterTolerance));
-  s.filterTwicing = mc.getBool("filterTwicing", s.filterTwicing);
+  s.filterTwicing = mc.getBool("filterTwicing", s.filter > 0);  // on wherever the filter is (bench/RESULTS.md)
   if (s.filterTwicing && view && !(s.filter > 0))
     ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
   s.allocation = readEnum(mc, "allocation", kMsCacheAllocations, s.allocation);

@@ -136,7 +136,7 @@ struct MsCacheSettings {
   // standard errors by which a neighbour may differ before it loses weight.
   float filter = 1.5f;
   float filterTolerance = 2;
-  bool filterTwicing = false;  // the filter's residual filtered and added back (ms_cache_filter.h, "Twicing")
+  bool filterTwicing = true;  // the filter's residual filtered and added back (ms_cache_filter.h, "Twicing"); default: filter > 0
   // closure "camera" or layout "view": the share of each path's first direction drawn about the
   // directions to the lights instead of by the phase function (kernels/shared/phase_guide.h); 0: none.
   float guide = 0;

@@ -245,7 +245,7 @@ TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
   EXPECT_EQ(s["ms_cache_paths"], 4);
   EXPECT_EQ(s["nan_pixels"], 0);
   EXPECT_NE(r.out.find("multiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
-                       "1.5 columns, tolerance 2 standard errors) in "),
+                       "1.5 columns, tolerance 2 standard errors, twiced) in "),
             std::string::npos)
       << r.out;
 }
@@ -264,20 +264,19 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   nlohmann::json s = stats("v.json");
   EXPECT_EQ(s["ms_cache_filter"], 1.0);
   EXPECT_EQ(s["ms_cache_filter_tolerance"], 3.0);
-  EXPECT_EQ(s["ms_cache_filter_twicing"], false);
+  EXPECT_EQ(s["ms_cache_filter_twicing"], true);  // by default wherever the filter is on
   EXPECT_EQ(s["nan_pixels"], 0);
   EXPECT_NE(r.out.find("multiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
-                       "1 columns, tolerance 3 standard errors) in "),
+                       "1 columns, tolerance 3 standard errors, twiced) in "),
             std::string::npos)
       << r.out;
   r = run("render s.json -o t.exr --stats-json t.json " + cache +
-          "--set renderer.raymarch.msCache.layout=\\\"view\\\" --set renderer.raymarch.msCache.filterTwicing=true");
+          "--set renderer.raymarch.msCache.layout=\\\"view\\\" --set renderer.raymarch.msCache.filterTwicing=false");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err, "");
-  EXPECT_EQ(stats("t.json")["ms_cache_filter_twicing"], true);
+  EXPECT_EQ(stats("t.json")["ms_cache_filter_twicing"], false);
   EXPECT_EQ(stats("t.json")["nan_pixels"], 0);
-  EXPECT_NE(r.out.find(", filtered (sigma 1 columns, tolerance 3 standard errors, twiced) in "), std::string::npos)
-      << r.out;
+  EXPECT_NE(r.out.find(", filtered (sigma 1 columns, tolerance 3 standard errors) in "), std::string::npos) << r.out;
   // The perceptual allocation (render/ms_cache_allocation.h): a mean of 4 paths, a pilot of 1, the
   // budgets within [0.625, 2.5] of the mean, reported in the line and the stats.
   r = run("render s.json -o a.exr --stats-json a.json " + cache +
@@ -291,7 +290,7 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   EXPECT_LE(budget[0].get<int>(), budget[1].get<int>());
   EXPECT_EQ(stats("a.json")["ms_cache_paths"], 4);
   EXPECT_NE(r.out.find("columns x rows x slices, a mean of 4 paths per node, filtered (sigma 1 columns, tolerance 3 "
-                       "standard errors), allocated perceptually ("),
+                       "standard errors, twiced), allocated perceptually ("),
             std::string::npos)
       << r.out;
   r = run("render s.json -o g.exr --stats-json g.json " + cache + "--set renderer.raymarch.msCache.layout=\\\"grid\\\"");

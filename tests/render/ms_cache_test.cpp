@@ -339,6 +339,7 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   const std::vector<float> plain = cacheAfter(scene, 48, 16);
   scene.renderer.raymarch.msCache.filter = 1.5f;
   scene.renderer.raymarch.msCache.filterTolerance = 2.0f;
+  scene.renderer.raymarch.msCache.filterTwicing = false;  // one pass first (the default twices: below)
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
   const ms_cache_params params = realtimeParams(scene, dev.scene).msCache;
   DeviceMsCache cache;

@@ -187,6 +187,7 @@ TEST(SceneDefaults, OptionalKeysTakeTheDocumentedDefaults) {
   EXPECT_EQ(r.raymarch.msCache.paths, 100);
   EXPECT_TRUE(r.raymarch.msCache.direct);
   EXPECT_EQ(r.raymarch.msCache.filter, 1.5f);
+  EXPECT_TRUE(r.raymarch.msCache.filterTwicing);  // wherever the filter is on
   EXPECT_EQ(r.raymarch.shadowSteps, 10);
   EXPECT_EQ(r.lobe.depthFactor, 20.0f);
   EXPECT_EQ(r.lobe.lobePoints, 30);
