@@ -124,15 +124,17 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
     ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
   s.interpolation = readEnum(mc, "interpolation", kMsCacheInterpolations, s.interpolation);
   s.resolution = readInt(mc, "resolution", s.resolution, 1, 256);
-  mc.note("tile", "integer or string", s.tile == kMsCacheTileAuto ? json("auto") : json(s.tile), "\"auto\", or [1, 256]");
+  mc.note("tile", "integer or string", s.tile == kMsCacheTileAuto ? json("auto") : json(s.tile),
+          "\"auto\", or [1, 256]");
   if (const json* tile = mc.find("tile")) {
+    const std::string key = mc.keyOf("tile");
     if (tile->is_string() && tile->get<std::string>() == "auto")
       s.tile = kMsCacheTileAuto;
     else if (tile->is_number())
-      s.tile = static_cast<int>(checkIntRange(ctx, mc.keyOf("tile"), toInteger(ctx, *tile, mc.keyOf("tile")), 1, 256));
+      s.tile = static_cast<int>(checkIntRange(ctx, key, toInteger(ctx, *tile, key), 1, 256));
     else
-      ctx.fail(mc.keyOf("tile"), "expected \"auto\" or pixels per column side, got " +
-                                     (tile->is_string() ? "\"" + tile->get<std::string>() + "\"" : std::string(tile->type_name())));
+      ctx.fail(key, "expected \"auto\" or pixels per column side, got " +
+                        (tile->is_string() ? "\"" + tile->get<std::string>() + "\"" : std::string(tile->type_name())));
   }
   // The direct light in the cache where a node can hold it (the camera's direction), else the march's.
   s.direct = mc.getBool("direct", view || s.closure == MsCacheClosure::Camera);
@@ -168,7 +170,6 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   mc.reportUnknown();
   return s;
 }
-
 
 RaymarchSettings readRaymarch(JsonContext& ctx, const json& value, const std::string& key, RaymarchSettings s) {
   ObjectReader m(ctx, value, key);

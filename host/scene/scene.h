@@ -136,12 +136,14 @@ struct MsCacheSettings {
   // standard errors by which a neighbour may differ before it loses weight.
   float filter = 1.5f;
   float filterTolerance = 2;
-  bool filterTwicing = true;  // the filter's residual filtered and added back (ms_cache_filter.h, "Twicing"); default: filter > 0
+  // The filter's residual filtered and added back (ms_cache_filter.h, "Twicing"); default: filter > 0.
+  bool filterTwicing = true;
   // closure "camera" or layout "view": the share of each path's first direction drawn about the
   // directions to the lights instead of by the phase function (kernels/shared/phase_guide.h); 0: none.
   float guide = 0;
   MsCacheAllocationKind allocation = MsCacheAllocationKind::Even;  // view only
-  int paths = 100;          // paths per node (allocated: their mean over the nodes holding medium); default: the quality's
+  // Paths per node (allocated: their mean over the nodes holding medium); default: the quality's.
+  int paths = 100;
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
 };
 
