@@ -89,7 +89,9 @@ ms_cache_params msCacheParams(const MsCacheSettings& mc, int tile, bool on, cons
     case MsCacheInterpolation::Geometric: p.interpolation = MS_CACHE_INTERPOLATION_GEOMETRIC; break;
     case MsCacheInterpolation::Linear: p.interpolation = MS_CACHE_INTERPOLATION_LINEAR; break;
   }
-  p.direct = on && mc.direct;
+  // Only a node aimed at the camera can hold the direct light (the loader refuses it elsewhere; a scene
+  // built in code keeps MsCacheSettings' default there).
+  p.direct = on && mc.direct && p.closure == MS_CACHE_CLOSURE_CAMERA;
   // The guide draws about the lights where the paths draw from the phase function (phase_guide.h).
   p.guide = on && p.closure == MS_CACHE_CLOSURE_CAMERA ? mc.guide : 0.0f;
   return p;

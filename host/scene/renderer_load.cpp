@@ -40,6 +40,22 @@ const EnumNames<Algorithm> kAlgorithms = {ALGORITHMS(ALGORITHM_NAME)};
 
 const json kNoKeys = json::object();
 
+// An integer in [lo, hi] or "auto" (autoValue): `what` names the integer in the message, `note` follows
+// its range ("(0 = off)").
+int readAutoInt(ObjectReader& r, const std::string& name, int current, int autoValue, int64_t lo, int64_t hi,
+                const std::string& what, const std::string& note) {
+  r.note(name, "integer or string", current == autoValue ? json("auto") : json(current),
+         "\"auto\", or [" + std::to_string(lo) + ", " + std::to_string(hi) + "]" + note);
+  const json* v = r.find(name);
+  if (!v) return current;
+  if (v->is_string() && v->get<std::string>() == "auto") return autoValue;
+  JsonContext& ctx = r.context();
+  const std::string key = r.keyOf(name);
+  if (v->is_number()) return static_cast<int>(checkIntRange(ctx, key, toInteger(ctx, *v, key), lo, hi));
+  ctx.fail(key, "expected \"auto\" or " + what + note + ", got " +
+                    (v->is_string() ? "\"" + v->get<std::string>() + "\"" : std::string(v->type_name())));
+}
+
 // A section of the renderer object, read whether given or not: every key of it gets its default
 // (KeyRecord), which a resolved scene writes out.
 const json& section(ObjectReader& r, const std::string& name) {
@@ -124,18 +140,7 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
     ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
   s.interpolation = readEnum(mc, "interpolation", kMsCacheInterpolations, s.interpolation);
   s.resolution = readInt(mc, "resolution", s.resolution, 1, 256);
-  mc.note("tile", "integer or string", s.tile == kMsCacheTileAuto ? json("auto") : json(s.tile),
-          "\"auto\", or [1, 256]");
-  if (const json* tile = mc.find("tile")) {
-    const std::string key = mc.keyOf("tile");
-    if (tile->is_string() && tile->get<std::string>() == "auto")
-      s.tile = kMsCacheTileAuto;
-    else if (tile->is_number())
-      s.tile = static_cast<int>(checkIntRange(ctx, key, toInteger(ctx, *tile, key), 1, 256));
-    else
-      ctx.fail(key, "expected \"auto\" or pixels per column side, got " +
-                        (tile->is_string() ? "\"" + tile->get<std::string>() + "\"" : std::string(tile->type_name())));
-  }
+  s.tile = readAutoInt(mc, "tile", s.tile, kMsCacheTileAuto, 1, 256, "pixels per column side", "");
   // The direct light in the cache where a node can hold it (the camera's direction), else the march's.
   s.direct = mc.getBool("direct", view || s.closure == MsCacheClosure::Camera);
   if (s.direct && !view && s.closure != MsCacheClosure::Camera)
@@ -237,19 +242,7 @@ LobeSettings readLobe(JsonContext& ctx, const json& value, const std::string& ke
 
 LightCacheSettings readLightCache(JsonContext& ctx, const json& value, const std::string& key, LightCacheSettings s) {
   ObjectReader c(ctx, value, key);
-  c.note("resolution", "integer or string", s.resolution == kLightCacheAuto ? json("auto") : json(s.resolution),
-         "\"auto\", or [0, 1024] (0 = off)");
-  if (const json* res = c.find("resolution")) {
-    if (res->is_string() && res->get<std::string>() == "auto")
-      s.resolution = kLightCacheAuto;
-    else if (res->is_number())
-      s.resolution = static_cast<int>(
-          checkIntRange(ctx, c.keyOf("resolution"), toInteger(ctx, *res, c.keyOf("resolution")), 0, 1024));
-    else
-      ctx.fail(c.keyOf("resolution"),
-               "expected \"auto\" or a number of cells (0 = off), got " +
-                   (res->is_string() ? "\"" + res->get<std::string>() + "\"" : std::string(res->type_name())));
-  }
+  s.resolution = readAutoInt(c, "resolution", s.resolution, kLightCacheAuto, 0, 1024, "a number of cells", " (0 = off)");
   c.reportUnknown();
   return s;
 }
