@@ -157,8 +157,8 @@ def view_cache(tile, paths, sigma, tolerance, **more):
 
 # The cache's pick per scene (a build under 60 s on 2 CPU cores; bench/RESULTS.md).
 CACHE_PICKS = {"cloud": view_cache(1, 100, 1.5, 2), "smoke": view_cache(1, 100, 1.5, 2),
-               "disney_cloud": view_cache(1, 136, 1.5, 2, filterTwicing=True, allocation="perceptual"),
-               "disney_cloud_front": view_cache(2, 480, 2, 0.5, guide=0.15)}
+               "disney_cloud": view_cache(1, 136, 1.5, 2, filterTwicing=True),
+               "disney_cloud_front": view_cache(2, 480, 2, 0.5)}
 METHODS = [("raymarch, single scattering", ["--algorithm", "raymarch", "--set",
                                             'renderer.raymarch.multipleScattering="none"']),
            ("raymarch + multiple-scattering cache", None),

@@ -15,8 +15,7 @@
 namespace narval {
 
 void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params,
-                           int targetPaths, int pathsPerLaunch, const std::string& sceneFile,
-                           const MsCacheAllocation& allocation, double budgetMs) {
+                           int targetPaths, int pathsPerLaunch, const std::string& sceneFile, double budgetMs) {
   const node_grid_params& c = params.grid;
   if (c.nx <= 0) throw std::invalid_argument("DeviceMsCache::refine: the cache is off (nx = 0)");
   const size_t nodes = nodeGridCount(c);
@@ -31,14 +30,8 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   restScene.camera = camera_params{};
   std::string key = rawBytes(restScene) + rawBytes(dev.scene.grid) + dev.buildOptions() +
                     (towardsCamera ? "camera" : "uniform") + std::to_string(params.layout) + "/" +
-                    std::to_string(params.tile) + (params.direct ? "/direct" : "") + "/guide" +
-                    rawBytes(params.guide);
+                    std::to_string(params.tile) + (params.direct ? "/direct" : "");
   const bool view = params.layout == MS_CACHE_LAYOUT_VIEW;
-  if (allocation.perceptual && !view)
-    throw std::invalid_argument("DeviceMsCache::refine: the perceptual allocation needs the view layout");
-  if (allocation.perceptual)
-    key += "/perceptual" + std::to_string(allocation.meanPaths) + "/" + toneMappingName(allocation.toneMapping) +
-           rawBytes(allocation.exposure);
   filterOn_ = view && params.filter > 0;
   twicingOn_ = filterOn_ && params.filter_twicing;
   for (int l = 0; l < pathScene.num_lights; ++l) key += rawBytes(dev.scene.lights[size_t(l)]);
@@ -94,15 +87,10 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
     }
     walkMajorants(rt, dev, pathScene);
     sceneBuf_ = constantBuffer(rt, pathScene);
-    const medium_params& m = pathScene.medium;
-    const double ss = double(m.sigma_s.x) + m.sigma_s.y + m.sigma_s.z;
-    const double st = ss + double(m.sigma_a.x) + m.sigma_a.y + m.sigma_a.z;
-    albedo_ = st > 0 ? ss / st : 0.0;
     statusBuf_ = cl::Buffer(rt.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
     rt.queue.enqueueFillBuffer(statusBuf_, cl_uint(0), 0, sizeof(cl_uint));
-    paths_ = budgetMin_ = budgetMax_ = sweepPaths_ = 0;
+    paths_ = sweepPaths_ = 0;
     sweepNode_ = 0;
-    allocation_ = allocation;
     ++rebuilds_;
     key_ = key;
     restKey_ = rest;
@@ -114,16 +102,9 @@ void DeviceMsCache::refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const m
   if (filterOn_ && filterPass_ > 0) filter(rt, params);  // a filtered copy under way first
   if (!place(rt, dev, params)) return;                   // budget spent before every column is placed
   if (reprojectPending_) reproject(rt, params);
-  int launches = targetPaths;
-  if (allocation_.perceptual) {  // the pilot first, then the budgets from it, then the launches they need
-    const int pilot = msAllocationPilot(allocation_.meanPaths);
-    if (paths_ < pilot) addPaths(rt, dev, params, std::min(targetPaths, pilot), pathsPerLaunch);
-    if (budgetMax_ == 0 && paths_ >= pilot && targetPaths > pilot) setBudgets(rt, params);
-    launches = budgetMax_ == 0 ? paths_ : allocatedLaunches(targetPaths);
-  }
-  if (paths_ < launches) addPaths(rt, dev, params, launches, pathsPerLaunch);
+  if (paths_ < targetPaths) addPaths(rt, dev, params, targetPaths, pathsPerLaunch);
   if (filterOn_) filter(rt, params);
-  if (priorOn_) blend(rt, params, targetPaths, paths_ >= launches && !filterPending());
+  if (priorOn_) blend(rt, params, targetPaths, paths_ >= targetPaths && !filterPending());
 }
 
 MsCacheSnapshot DeviceMsCache::snapshot(ClRuntime& rt) const {
@@ -132,8 +113,6 @@ MsCacheSnapshot DeviceMsCache::snapshot(ClRuntime& rt) const {
   if (!s.nodes.empty()) rt.queue.enqueueReadBuffer(buffer_, CL_TRUE, 0, bytes_, s.nodes.data());
   s.paths = paths_;
   s.sweepPaths = sweepPaths_;
-  s.budgetMin = budgetMin_;
-  s.budgetMax = budgetMax_;
   s.sweepNode = sweepNode_;
   s.placed = placed_ == size_t(-1) ? UINT64_MAX : uint64_t(placed_);
   s.camera = camera_;
@@ -167,8 +146,6 @@ void DeviceMsCache::restore(ClRuntime& rt, const ms_cache_params& params) {
   rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, s.nodes.data());
   paths_ = s.paths;
   sweepPaths_ = s.sweepPaths;
-  budgetMin_ = s.budgetMin;
-  budgetMax_ = s.budgetMax;
   sweepNode_ = size_t(s.sweepNode);
   placed_ = s.placed == UINT64_MAX ? size_t(-1) : size_t(s.placed);
 }
@@ -176,42 +153,6 @@ void DeviceMsCache::restore(ClRuntime& rt, const ms_cache_params& params) {
 double DeviceMsCache::pathsDone() const {
   const size_t nodes = bytes_ / (MS_CACHE_STRIDE * sizeof(float));
   return paths() + (nodes > 0 ? double(sweepPaths_) * double(sweepNode_) / double(nodes) : 0.0);
-}
-
-int DeviceMsCache::paths() const {
-  if (!allocation_.perceptual || budgetMax_ == 0) return paths_;
-  if (paths_ >= budgetMax_) return allocation_.meanPaths;
-  // Between the pilot and the largest budget, pro rata: the caller's progress towards the mean.
-  const int pilot = msAllocationPilot(allocation_.meanPaths);
-  return pilot + int(int64_t(paths_ - pilot) * (allocation_.meanPaths - pilot) / (budgetMax_ - pilot));
-}
-
-// The budgets (ms_cache_allocation.h) from the pilot's means, written into every node of their
-// column (MS_VIEW_BUDGET): one read-back and one write of the whole cache, once per cache.
-void DeviceMsCache::setBudgets(ClRuntime& rt, const ms_cache_params& params) {
-  const node_grid_params& c = params.grid;
-  std::vector<float> nodes(bytes_ / sizeof(float));
-  rt.queue.enqueueReadBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
-  const std::vector<int> budgets = msPerceptualBudgets(msColumnPilots(nodes, c, albedo_), c.nx, c.ny, allocation_);
-  const size_t columns = size_t(c.nx) * size_t(c.ny);
-  budgetMin_ = allocation_.meanPaths;
-  for (size_t col = 0; col < columns; ++col) {
-    if (budgets[col] <= 0) continue;
-    budgetMin_ = std::min(budgetMin_, budgets[col]);
-    budgetMax_ = std::max(budgetMax_, budgets[col]);
-    for (int s = 0; s < c.nz; ++s) nodes[(size_t(s) * columns + col) * MS_CACHE_STRIDE + MS_VIEW_BUDGET] = float(budgets[col]);
-  }
-  if (budgetMax_ == 0) budgetMin_ = budgetMax_ = allocation_.meanPaths;  // no column holds medium
-  rt.queue.enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes_, nodes.data());
-}
-
-// The launch index a target of `targetPaths` mean paths stands for once the budgets are set: the
-// largest budget at the mean, pro rata between the pilot and it (paths() is its inverse).
-int DeviceMsCache::allocatedLaunches(int targetPaths) const {
-  const int mean = allocation_.meanPaths, pilot = msAllocationPilot(mean);
-  if (targetPaths >= mean) return budgetMax_;
-  if (targetPaths <= pilot) return targetPaths;
-  return pilot + int((int64_t(targetPaths - pilot) * (budgetMax_ - pilot) + (mean - pilot) - 1) / (mean - pilot));
 }
 
 // The paths are the path tracer's, so they walk its majorant grid (majorant_options.h: 32 cells on

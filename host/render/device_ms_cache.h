@@ -12,7 +12,6 @@
 #include "cl/cl_runtime.h"
 #include "cl/device_allocation.h"
 #include "render/device_scene.h"
-#include "render/ms_cache_allocation.h"
 #include "shared/structs.h"
 
 namespace narval {
@@ -20,7 +19,7 @@ namespace narval {
 // A cache's nodes and progress, as read back for a file (render/ms_cache_file.h) and restored from one.
 struct MsCacheSnapshot {
   std::vector<float> nodes;  // MS_CACHE_STRIDE floats per node (ms_cache.h, "Storage")
-  int paths = 0, sweepPaths = 0, budgetMin = 0, budgetMax = 0;
+  int paths = 0, sweepPaths = 0;
   uint64_t sweepNode = 0, placed = 0;  // the sweep under way; the view layout's columns placed
   camera_params camera{};  // the view layout's: the camera its nodes are placed and aimed for
 };
@@ -29,17 +28,14 @@ class DeviceMsCache {
  public:
   // Brings the cache to at least `targetPaths` paths per node for the scene on `dev` and params.grid (nx > 0),
   // in launches of at most `pathsPerLaunch`, starting over when the scene changed; InputError (naming
-  // `sceneFile` and renderer.raymarch.msCache.resolution) when over the device's largest allocation. With
-  // allocation.perceptual (view layout; ms_cache_allocation.h) nodes take the pilot, then columns their budgets
-  // (averaging allocation.meanPaths, towards which `targetPaths` counts; paths() reaches it once all are spent).
+  // `sceneFile` and renderer.raymarch.msCache.resolution) when over the device's largest allocation.
   // With budgetMs > 0 it stops once about that much build time (by profiling events) is spent, in slices
   // of nodes sized by the last slice's cost per node and path (at least one slice a call, so every call
   // progresses): a viewer's frame never waits for a whole launch. Budgeted sweeps add as many paths as
   // the nodes hold (1, 1, 2, 4, ... up to pathsPerLaunch), so the noise halves sweep by sweep. A node's
   // paths are the same whatever the slices and sweeps, so the cache after K paths is too, bit for bit.
   void refine(ClRuntime& rt, const DeviceSceneBuffers& dev, const ms_cache_params& params, int targetPaths,
-              int pathsPerLaunch, const std::string& sceneFile, const MsCacheAllocation& allocation = {},
-              double budgetMs = 0);
+              int pathsPerLaunch, const std::string& sceneFile, double budgetMs = 0);
   // The nodes and progress so far (one read-back).
   MsCacheSnapshot snapshot(ClRuntime& rt) const;
   // The next start (the first refine) takes `snapshot` for its nodes and progress instead of zeros: a
@@ -59,15 +55,12 @@ class DeviceMsCache {
   }
   bool reprojected() const { return priorOn_; }  // a camera move's prior is drawn
   const cl::Buffer& means() const { return buffer_; }  // the running means, unfiltered
-  int paths() const;                               // paths per node so far (allocated: their mean, pro rata)
+  int paths() const { return paths_; }             // paths per node so far
   // paths() plus the share of the sweep under way (a budgeted refine may stop between its slices).
   double pathsDone() const;
   int launches() const { return launches_; }       // build launches so far, slices included
   // A budgeted refine has yet to make the filtered copy of the paths so far (the view layout's filter).
   bool filterPending() const { return filterOn_ && (filterPass_ > 0 || filteredPaths_ != paths_); }
-  // The perceptual allocation's smallest and largest budget (0, 0 before it is set or when off).
-  int budgetMin() const { return budgetMin_; }
-  int budgetMax() const { return budgetMax_; }
   int rebuilds() const { return rebuilds_; }       // times it started over (1 for one scene)
   double buildMs() const { return buildMs_; }      // launch time by profiling events, all launches
   size_t bytes() const { return bytes_; }
@@ -93,9 +86,6 @@ class DeviceMsCache {
   size_t sliceEnd(size_t first, size_t end, double units) const;
   void countActive(ClRuntime& rt, const ms_cache_params& params);
   double unitsThatFit(double msPerUnit, double pilot, size_t lastUnits) const;
-  // The perceptual allocation (ms_cache.cpp): budgets after the pilot, and the launch index `targetPaths` maps to.
-  void setBudgets(ClRuntime& rt, const ms_cache_params& params);
-  int allocatedLaunches(int targetPaths) const;
   // The majorant grid the paths walk into pathScene and majorantBuf_ (ms_cache.cpp).
   void walkMajorants(ClRuntime& rt, const DeviceSceneBuffers& dev, scene_params& pathScene);
 
@@ -141,9 +131,6 @@ class DeviceMsCache {
   double msPerNodePath_ = 0, msPerColumn_ = 0, msPerPlace_ = 0;
   size_t lastNodes_ = 0, lastColumns_ = 0, lastPlaced_ = 0;
   std::vector<size_t> activePrefix_;
-  MsCacheAllocation allocation_;
-  double albedo_ = 0;  // the medium's grey albedo σs/σt (channel sums), which the allocation's Y takes
-  int budgetMin_ = 0, budgetMax_ = 0;  // set: the budgets are in the nodes
   double buildMs_ = 0;
   size_t bytes_ = 0;
   uint32_t status_ = 0;

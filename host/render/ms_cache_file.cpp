@@ -76,7 +76,6 @@ void writeMsCacheFile(const std::string& path, const MsCacheFile& file) {
                                  {"sweep_paths", s.sweepPaths},
                                  {"sweep_node", s.sweepNode},
                                  {"placed", s.placed},
-                                 {"budget", {s.budgetMin, s.budgetMax}},
                                  {"camera", cameraJson(s.camera)}};
   const std::string head = std::string(kMagic) + header.dump() + "\n";
   AtomicFile out(path);
@@ -106,8 +105,6 @@ MsCacheFile readMsCacheFile(const std::string& path, const std::string& flag, co
     s.sweepPaths = h.at("sweep_paths").get<int>();
     s.sweepNode = h.at("sweep_node").get<uint64_t>();
     s.placed = h.at("placed").get<uint64_t>();
-    s.budgetMin = h.at("budget").at(0).get<int>();
-    s.budgetMax = h.at("budget").at(1).get<int>();
     if (h.contains("camera")) s.camera = cameraFromJson(h.at("camera"));  // absent before view files held it
   } catch (const nlohmann::json::exception&) {
     throw notACache;

@@ -92,8 +92,6 @@ ms_cache_params msCacheParams(const MsCacheSettings& mc, int tile, bool on, cons
   // Only a node aimed at the camera can hold the direct light (the loader refuses it elsewhere; a scene
   // built in code keeps MsCacheSettings' default there).
   p.direct = on && mc.direct && p.closure == MS_CACHE_CLOSURE_CAMERA;
-  // The guide draws about the lights where the paths draw from the phase function (phase_guide.h).
-  p.guide = on && p.closure == MS_CACHE_CLOSURE_CAMERA ? mc.guide : 0.0f;
   return p;
 }
 

@@ -111,14 +111,7 @@ double RealtimeRenderer::renderFrame(double cacheBudgetMs, double* wallMs) {
   }
   if (params_.msCache.grid.nx > 0) {  // built to its paths (within a budget: over frames), then kept
     const MsCacheSettings& mc = view_.renderer.raymarch.msCache;
-    MsCacheAllocation allocation;
-    allocation.perceptual =
-        mc.layout == MsCacheLayout::View && mc.allocation == MsCacheAllocationKind::Perceptual;
-    allocation.meanPaths = mc.paths;
-    allocation.toneMapping = view_.renderer.toneMapping;
-    allocation.exposure = view_.renderer.exposure;
-    msCache_.refine(rt_, dev_, params_.msCache, mc.paths, mc.pathsPerLaunch, view_.sourcePath, allocation,
-                    cacheBudgetMs);
+    msCache_.refine(rt_, dev_, params_.msCache, mc.paths, mc.pathsPerLaunch, view_.sourcePath, cacheBudgetMs);
     kernel_.set("ms_cache_nodes", msCache_.buffer());
   }
   const int W = view_.renderer.width, H = view_.renderer.height;
@@ -163,9 +156,6 @@ RenderResult RealtimeRenderer::result() {
   } else {
     nodeGridCells(mc.grid, ms.cells);
   }
-  ms.guide = mc.guide;
-  ms.budgetMin = msCache_.budgetMin();
-  ms.budgetMax = msCache_.budgetMax();
   result.image = imageFromRgba(rgba, W, H, 1.0f, &st.nanPixels);
   return result;
 }

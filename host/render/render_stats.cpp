@@ -41,8 +41,6 @@ void addJson(nlohmann::json& j, const MsCacheStats& c) {
   j["ms_cache_filter"] = c.filter;
   j["ms_cache_filter_tolerance"] = c.filterTolerance;
   j["ms_cache_filter_twicing"] = c.filterTwicing;
-  j["ms_cache_guide"] = c.guide;
-  j["ms_cache_budget"] = {c.budgetMin, c.budgetMax};
 }
 
 nlohmann::json statsJson(const RenderStats& s, uint32_t seed, const std::string& scenePath) {
@@ -93,14 +91,11 @@ std::string describe(const MsCacheStats& c) {
   if (c.builds == 0) return "";
   std::ostringstream line;
   line << "multiple-scattering cache: " << c.cells[0] << "x" << c.cells[1] << "x" << c.cells[2]
-       << (c.view ? " columns x rows x slices, " : " cells, ") << (c.budgetMax > 0 ? "a mean of " : "") << c.paths
-       << " paths per node";
+       << (c.view ? " columns x rows x slices, " : " cells, ") << c.paths << " paths per node";
   if (c.progress < 1) line << " (" << int(c.progress * 100) << "% of the paths asked for)";
   if (c.filter > 0)
     line << ", filtered (sigma " << c.filter << " columns, tolerance " << c.filterTolerance << " standard errors"
          << (c.filterTwicing ? ", twiced" : "") << ")";
-  if (c.guide > 0) line << ", guided towards the lights (share " << c.guide << ")";
-  if (c.budgetMax > 0) line << ", allocated perceptually (" << c.budgetMin << "-" << c.budgetMax << " paths a column)";
   line << " in " << c.ms << " ms (not in the frame times)\n";
   return line.str();
 }

@@ -41,8 +41,7 @@ struct LightCacheStats {
 // The ray marcher's multiple-scattering cache (render/device_ms_cache.h): cells per axis (0 0 0:
 // off; the view layout: columns, rows and slices), paths per node, times it was started (1), its
 // build time apart from the frames; the view layout's filter (σ_s in columns, 0: off; its tolerance
-// k; twicing), the share of the paths' first directions drawn towards the lights, and the
-// perceptual allocation's smallest and largest paths per column (0, 0: the even share).
+// k; twicing).
 struct MsCacheStats {
   int cells[3] = {0, 0, 0};
   bool view = false;
@@ -51,8 +50,6 @@ struct MsCacheStats {
   double ms = 0;
   float filter = 0, filterTolerance = 0;
   bool filterTwicing = false;
-  float guide = 0;
-  int budgetMin = 0, budgetMax = 0;
 };
 
 struct RenderStats {

@@ -28,8 +28,6 @@ const EnumNames<MsCacheInterpolation> kMsCacheInterpolations = {{"geometric", Ms
 const EnumNames<ShadowWeighting> kShadowWeightings = {{"area", ShadowWeighting::Area},
                                                       {"phase", ShadowWeighting::Phase}};
 const EnumNames<MsCacheLayout> kMsCacheLayouts = {{"grid", MsCacheLayout::Grid}, {"view", MsCacheLayout::View}};
-const EnumNames<MsCacheAllocationKind> kMsCacheAllocations = {{"even", MsCacheAllocationKind::Even},
-                                                              {"perceptual", MsCacheAllocationKind::Perceptual}};
 const EnumNames<RaymarchQuality> kRaymarchQualities = {{"draft", RaymarchQuality::Draft},
                                                         {"interactive", RaymarchQuality::Interactive},
                                                         {"high", RaymarchQuality::High}};
@@ -157,20 +155,11 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   s.filterTwicing = mc.getBool("filterTwicing", s.filter > 0);  // on wherever the filter is (bench/RESULTS.md)
   if (s.filterTwicing && view && !(s.filter > 0))
     ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
-  s.allocation = readEnum(mc, "allocation", kMsCacheAllocations, s.allocation);
-  s.guide = readNonNegative(mc, "guide", s.guide);
-  mc.noteRange("guide", "[0, 1)");
-  if (!(s.guide < 1))
-    ctx.fail(mc.keyOf("guide"), "must be below 1 (the phase function's share covers every direction), got " +
-                                    formatNumber(s.guide));
-  else if (s.guide > 0 && !view && s.closure != MsCacheClosure::Camera)
-    ctx.fail(mc.keyOf("guide"), "needs closure \"camera\" or layout \"view\" (the uniform closures draw no "
-                                "phase-function directions to guide)");
   s.paths = readInt(mc, "paths", s.paths, 1, 1 << 20);
   s.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.pathsPerLaunch, 1, 1 << 20);
   for (const char* grid : {"resolution", "interpolation"})
     if (view) ctx.warnIfChanged(mc.keyOf(grid), "applies to layout \"grid\"; \"view\" ignores it");
-  for (const char* own : {"tile", "slices", "filter", "filterTolerance", "filterTwicing", "allocation"})
+  for (const char* own : {"tile", "slices", "filter", "filterTolerance", "filterTwicing"})
     if (!view) ctx.warnIfChanged(mc.keyOf(own), "applies to layout \"view\"; \"grid\" ignores it");
   mc.reportUnknown();
   return s;

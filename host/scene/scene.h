@@ -108,9 +108,6 @@ enum class MsCacheInterpolation { Geometric, Linear };
 // Its nodes: a grid over the medium's box, or image columns with nodes along their optical depth from the
 // camera (kernels/shared/ms_cache_view.h).
 enum class MsCacheLayout { Grid, View };
-// How the view layout spreads its paths over its columns: the same number each, or by what their
-// noise costs the eye (host/render/ms_cache_allocation.h).
-enum class MsCacheAllocationKind { Even, Perceptual };
 // renderer.raymarch.quality: what the multiple-scattering cache's defaults aim for. Each sets the
 // march's steps (with the cache on), the cache's paths per node and, for msCache.tile "auto", how
 // many columns a CPU device gets (realtime_params.h, msCacheTile); explicit keys override it.
@@ -138,11 +135,7 @@ struct MsCacheSettings {
   float filterTolerance = 2;
   // The filter's residual filtered and added back (ms_cache_filter.h, "Twicing"); default: filter > 0.
   bool filterTwicing = true;
-  // closure "camera" or layout "view": the share of each path's first direction drawn about the
-  // directions to the lights instead of by the phase function (kernels/shared/phase_guide.h); 0: none.
-  float guide = 0;
-  MsCacheAllocationKind allocation = MsCacheAllocationKind::Even;  // view only
-  // Paths per node (allocated: their mean over the nodes holding medium); default: the quality's.
+  // Paths per node; default: the quality's.
   int paths = 100;
   int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
 };

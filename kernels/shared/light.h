@@ -74,8 +74,8 @@ static inline vec3 light_escaped(NV_CONSTANT const light_params* l, vec3 d) {
   }
 }
 
-/* Unit direction from x to the light's centre (0 when x is there) and *dist, the distance: the cache's
- * guide's axis, and the real-time shadow ray of a light taken as one point. */
+/* Unit direction from x to the light's centre (0 when x is there) and *dist, the distance: the
+ * real-time shadow ray of a light taken as one point. */
 static inline vec3 light_axis(NV_CONSTANT const light_params* l, vec3 x, NV_PRIVATE float* dist) {
   switch (LIGHT_KIND(l)) {
     LIGHT_KINDS(LIGHT_CASE_AXIS)

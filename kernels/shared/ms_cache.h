@@ -60,16 +60,8 @@
  * wherever it points (back-lit clouds: march.h, march_light_column_phase), at the path tracer's variance
  * and more build time (bench/RESULTS.md).
  *
- * Guide (ms_cache_params.guide; closure camera or the view layout only): a share of each path's first
- * directions comes from HG lobes about the directions to the lights (phase_guide.h), weighted by
- * phase/mixture density, both MIS weights at its start using the mixture's density: the node's
- * expectation is unchanged. In a cloud lit from the camera's side a node's light towards the camera
- * arrives mostly from the lights' side, away from the phase function's peak about −w_c
- * (bench/RESULTS.md).
- *
  * Storage: MS_CACHE_STRIDE floats per node. The running means of the paths so far: R (rgb), their count,
- * then b per channel (xyz, then a float: after red's the view layout's budget, after green's
- * MS_CACHE_SQUARE for the view filter's noise, after blue's the view column's background;
+ * then b per channel (xyz, then a float: after green's MS_CACHE_SQUARE for the view filter's noise;
  * ms_cache_view.h; the view layout holds its turn where red's b is, and no b). Then, written by the
  * build after each launch so that a lookup (one per march sample) takes no logarithm or division per
  * corner: ln R (MS_CACHE_LOG_R) and b/R (MS_CACHE_RATIO; the grid layout only). Each launch

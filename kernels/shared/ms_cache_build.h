@@ -11,9 +11,6 @@
 
 /* Offsets the scene's seed so that node n's paths never share pixel n's camera samples' numbers. */
 #define MS_CACHE_SEED_OFFSET 0x6d73u
-/* The guide lobes' HG g (phase_guide.h; ms_cache.h, "Guide"), chosen by the relMSE between two cache
- * seeds, each g at its best share, on the front-lit Disney cloud, checked back-lit (bench/RESULTS.md). */
-#define MS_CACHE_GUIDE_G 0.6f
 
 /* Leading coordinates of node `node`'s path k: its start in the slice and the light its next-event
  * estimate picks (u[0], u[1]), its direction (u[2], u[3]), the point on the light (u[4], u[5]). The result
@@ -58,8 +55,7 @@ static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int clo
 
 /* Path k's estimate at node `node` and the direction ω it looked along: the rest's radiance arriving
  * at world point x (a grid node's; a view node's path draws its own in the slice, ms_cache_view.h),
- * plus the next-event estimate with the direct light (ms_cache.h, "Direct"). With the guide ("Guide")
- * ω comes from phase_guide_sample, weighted by phase/mixture density; both MIS weights use the mixture's.
+ * plus the next-event estimate with the direct light (ms_cache.h, "Direct").
  * *turn: with the camera closure, the estimate's change as w_c turns (ms_cache_reproject.h, "Direction"):
  * the scattered part's grey value times the score of its direction, d ln p/dμ·(s − μ·w_c), s = −ω,
  * μ = s·w_c (the direct light's own change is left out); 0 otherwise. */
@@ -76,23 +72,10 @@ static inline vec3 ms_cache_path(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache
   if (view) x = ms_view_sample_point(KERNEL_CONTEXT_ARG, mc, node, v, u[0]); /* in its slice */
   float pdf;
   const vec3 w_c = ms_cache_to_camera(s, x);
-  phase_guide gd = phase_guide_none();
-  float weight = 1.0f; /* p/pdf of the direction (1 without a guide: sampling is exact) */
-  if (closure == MS_CACHE_CLOSURE_CAMERA && mc->guide > 0.0f) {
-    gd.x = x;
-    gd.share = mc->guide;
-    gd.g = MS_CACHE_GUIDE_G;
-    float f;
-    *omega = phase_guide_sample(ctx->lights, s->num_lights, s->medium.phase, vec3_scale(w_c, -1.0f), gd,
-                                u[2], u[3], u[1], &f, &pdf);
-    weight = pdf > 0.0f ? f / pdf : 0.0f;
-  } else {
-    *omega = ms_cache_direction(s, closure, w_c, u[2], u[3], &pdf);
-  }
+  *omega = ms_cache_direction(s, closure, w_c, u[2], u[3], &pdf);
   vec3 L = vec3_splat(0.0f);
-  if (direct) L = pathtrace_direct_at(KERNEL_CONTEXT_ARG, x, vec3_scale(w_c, -1.0f), u[1], u[4], u[5], gd, &rng);
-  const vec3 scattered =
-      vec3_scale(pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, direct ? pdf : 0.0f, &rng), weight);
+  if (direct) L = pathtrace_direct_at(KERNEL_CONTEXT_ARG, x, vec3_scale(w_c, -1.0f), u[1], u[4], u[5], &rng);
+  const vec3 scattered = pathtrace_radiance(KERNEL_CONTEXT_ARG, x, *omega, direct, direct ? pdf : 0.0f, &rng);
   *turn = vec3_splat(0.0f);
   if (closure == MS_CACHE_CLOSURE_CAMERA) {
     const vec3 sc = vec3_scale(*omega, -1.0f);
@@ -174,7 +157,7 @@ static inline void ms_cache_refine_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
 
 /* One launch's work for node `node` (ms_cache.cl): paths [first, first + count). A grid node no lookup
  * reads stays 0 (ms_cache_node_is_read); a view node (placed by ms_view_place_column) takes none when
- * its column holds no medium, nor past its budget (MS_VIEW_BUDGET). */
+ * its column holds no medium. */
 static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms_cache_params* mc, int node,
                                        NV_GLOBAL float* v, uint first, uint count) {
   NV_PRIVATE const node_grid_params* c = &mc->grid;
@@ -187,11 +170,6 @@ static inline void ms_cache_build_node(KERNEL_CONTEXT_PARAM, NV_PRIVATE const ms
       return;
     case MS_CACHE_LAYOUT_VIEW: { /* each path draws its point in the slice */
       if (!(v[MS_VIEW_TAU] >= 0.0f)) return;
-      const uint budget = (uint)v[MS_VIEW_BUDGET];
-      if (budget > 0u) {
-        if (first >= budget) return;
-        count = budget - first < count ? budget - first : count;
-      }
       ms_cache_refine_node(KERNEL_CONTEXT_ARG, mc, vec3_splat(0.0f), node, v, first, count);
       return;
     }

@@ -33,7 +33,7 @@
  * fraction of a path, so the first new paths replace it; a thin medium, whose paths are less noisy,
  * trusts its prior less at the same turn (bench/RESULTS.md).
  *
- * Blend (ms_view_blend_node): with n new paths at a node (its budget or `target` of them to come), its
+ * Blend (ms_view_blend_node): with n new paths at a node (`target` of them to come), its
  * prior of m paths counts m·(1 − n/N): the drawn value is the weighted mean, the prior's share falls
  * as the new paths come in and is 0 when they are all in, so the cache ends as one built at the new
  * pose from nothing, bit for bit (the host then drops the prior). */
@@ -105,7 +105,7 @@ static inline void ms_view_blend_node(NV_GLOBAL const float* prior, NV_GLOBAL co
                                       NV_GLOBAL float* out) {
   for (int i = 0; i < MS_CACHE_STRIDE; ++i) out[i] = fresh[i];
   if (!(fresh[MS_VIEW_TAU] >= 0.0f)) return;
-  const float n = fresh[3], N = fresh[MS_VIEW_BUDGET] > 0.0f ? fresh[MS_VIEW_BUDGET] : (float)target;
+  const float n = fresh[3], N = (float)target;
   const float m = prior[3] * nv_fmax(0.0f, 1.0f - n / nv_fmax(N, 1.0f));
   if (!(n > 0.0f)) { /* no new path yet: the prior alone */
     for (int i = 0; i < 4; ++i) out[i] = prior[i];

@@ -47,14 +47,9 @@
 #define MS_VIEW_T 30
 #define MS_VIEW_TAU_END 31
 #define MS_VIEW_T_END 19
-/* BUDGET: the paths a node takes (ms_cache_build.h; 0: as each launch asks), from the host's perceptual
- * allocation (render/ms_cache_allocation.h). SEEN, on slice 0: the background's light through the
- * column's last level, T_end·grey(L_b), which that allocation weighs by. */
 /* TURN (3 floats): the mean of the paths' turn, the node's grey value's gradient as the direction to the
  * camera turns (ms_cache_build.h, ms_cache_path; ms_cache_reproject.h). */
 #define MS_VIEW_TURN 4
-#define MS_VIEW_BUDGET 7
-#define MS_VIEW_SEEN 15
 #define MS_VIEW_T_MIN 0.01f
 #define MS_VIEW_PLACE_STEPS 256
 #define MS_VIEW_SAMPLE_STEPS 16 /* a path's march across its slice to its drawn τ */
@@ -108,7 +103,7 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
   for (int slice = 0; slice < c->nz; ++slice) {
     NV_GLOBAL float* v = cache + (size_t)slice * slice_stride;
     v[MS_VIEW_TAU] = v[MS_VIEW_TAU_END] = -1.0f;
-    v[MS_VIEW_T] = v[MS_VIEW_T_END] = v[MS_VIEW_BUDGET] = v[MS_VIEW_SEEN] = 0.0f;
+    v[MS_VIEW_T] = v[MS_VIEW_T_END] = 0.0f;
   }
   medium_segment seg;
   vec3 Lb;
@@ -129,7 +124,6 @@ static inline void ms_view_place_column(KERNEL_CONTEXT_PARAM, NV_PRIVATE const m
   const float total = sigma * (sum * it.delta);
   if (!(total > 0.0f)) return;
   const float t_end = nv_fmax(nv_exp(-total), MS_VIEW_T_MIN);
-  cache[MS_VIEW_SEEN] = t_end * vec3_average(Lb);
   int i = 0;
   float acc = 0.0f, end = seg.t0;
   for (int k = 0; k < samples && i <= c->nz; ++k) {

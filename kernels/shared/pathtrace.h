@@ -19,7 +19,6 @@
 #include "shared/light_select.h"
 #include "shared/medium.h"
 #include "shared/phase.h"
-#include "shared/phase_guide.h"
 #include "shared/tracking.h"
 
 /* Transmittance from x to the light point at distance `dist` along unit dir: 0 if another
@@ -40,10 +39,9 @@ static inline vec3 pathtrace_shadow(KERNEL_CONTEXT_PARAM, int light_index, vec3 
 
 /* Light i's next-event estimate at scattering point x for a path arriving along w_in, aimed at the
  * light point (u1, u2) picks, divided by the probability of aiming at it (light_select_prob, as a
- * rectangle hit's MIS weight uses); the shadow ray draws from rng. gd: how the event draws its next
- * direction (phase_guide.h; phase_guide_none(): the phase function), the density MIS weighs against. */
+ * rectangle hit's MIS weight uses); the shadow ray draws from rng. */
 static inline vec3 pathtrace_light_at(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 w_in, float u1, float u2,
-                                      phase_guide gd, NV_PRIVATE rng_state* rng) {
+                                      NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   NV_CONSTANT const light_params* lights = ctx->lights;
   const float prob = light_select_prob(s, lights, i);
@@ -57,38 +55,36 @@ static inline vec3 pathtrace_light_at(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 
   const vec3 tr = pathtrace_shadow(KERNEL_CONTEXT_ARG, i, x, ls.dir, ls.dist, rng);
   if (vec3_is_zero(tr)) return vec3_splat(0.0f);
   /* Point light: Le·f·Tr·I/d² / prob. Rectangle: Le·f·Tr/(prob·pdf_light) weighted against the
-   * direction sampling, whose pdf is f (sampling is exact), or the guide's mixture (phase_guide.h). */
+   * direction sampling, whose pdf is f (sampling is exact). */
   const float light_pdf = prob * ls.pdf;
   const float w =
-      light_pdf > 0.0f ? mis_power_heuristic(light_pdf, phase_guide_pdf(lights, s->num_lights, gd, f, ls.dir)) / light_pdf
-                       : 1.0f / prob;
+      light_pdf > 0.0f ? mis_power_heuristic(light_pdf, f) / light_pdf : 1.0f / prob;
   return vec3_scale(vec3_mul(ls.radiance, tr), f * w);
 }
 
 /* pathtrace_light_at with the light point drawn from rng. */
 static inline vec3 pathtrace_light(KERNEL_CONTEXT_PARAM, int i, vec3 x, vec3 w_in, NV_PRIVATE rng_state* rng) {
   const float u1 = rng_uniform(rng), u2 = rng_uniform(rng);
-  return pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, phase_guide_none(), rng);
+  return pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, rng);
 }
 
 /* pathtrace_direct with its leading numbers given: u_select picks the light (one per event), (u1, u2)
  * the point aimed at on every light; shadow rays draw from rng. For callers stratifying them over many
  * estimates at one point (ms_cache_build.h); the path tracer draws all from rng in turn (a light's
- * numbers after the previous shadow ray, none when no light can be picked), which this cannot share.
- * gd: as in pathtrace_light_at. */
+ * numbers after the previous shadow ray, none when no light can be picked), which this cannot share. */
 static inline vec3 pathtrace_direct_at(KERNEL_CONTEXT_PARAM, vec3 x, vec3 w_in, float u_select, float u1, float u2,
-                                       phase_guide gd, NV_PRIVATE rng_state* rng) {
+                                       NV_PRIVATE rng_state* rng) {
   NV_CONSTANT const scene_params* s = ctx->scene;
   switch (s->light_sampling) {
     case LIGHT_SAMPLING_ALL: {
       vec3 sum = vec3_splat(0.0f);
       for (int i = 0; i < s->num_lights; ++i)
-        sum = vec3_add(sum, pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, gd, rng));
+        sum = vec3_add(sum, pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, rng));
       return sum;
     }
     case LIGHT_SAMPLING_ONE: {
       const int i = light_select(ctx->lights, s->num_lights, u_select);
-      return i < 0 ? vec3_splat(0.0f) : pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, gd, rng);
+      return i < 0 ? vec3_splat(0.0f) : pathtrace_light_at(KERNEL_CONTEXT_ARG, i, x, w_in, u1, u2, rng);
     }
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry (scene_kinds.h) */
   }

@@ -1,7 +1,7 @@
 /* phase_hg.h: Henyey-Greenstein, p(μ) = (1 − g²) / (4π (1 + g² − 2gμ)^{3/2}), normalised over the sphere;
  * coef.x = g. The dissertation's printed form (§2.6.2) drops the 3/2 exponent: a typo. Sampling inverts the
  * CDF exactly (pdf == eval, weight 1). The raw functions of g (phase_hg_eval, phase_hg_sample_cos) also
- * serve the guide's lobes (phase_guide.h) and Mie's forward lobe. */
+ * serve Mie's forward lobe. */
 #ifndef NARVAL_PHASE_HG_H
 #define NARVAL_PHASE_HG_H
 

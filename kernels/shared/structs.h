@@ -194,10 +194,10 @@ typedef struct ms_cache_params {
   int filter_twicing;     /* the view layout, filter on: 1: the residual filtered and added back ("Twicing") */
   float filter;           /* the view layout: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
   float filter_tolerance; /* the filter's k: standard errors a neighbour may differ by */
-  float guide;            /* closure camera: share of first path directions drawn towards the lights (phase_guide.h) */
   int pad0;
   int pad1;
   int pad2;
+  int pad3;
 } ms_cache_params;
 
 typedef struct scene_params {

@@ -277,22 +277,6 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   EXPECT_EQ(stats("t.json")["ms_cache_filter_twicing"], false);
   EXPECT_EQ(stats("t.json")["nan_pixels"], 0);
   EXPECT_NE(r.out.find(", filtered (sigma 1 columns, tolerance 3 standard errors) in "), std::string::npos) << r.out;
-  // The perceptual allocation (render/ms_cache_allocation.h): a mean of 4 paths, a pilot of 1, the
-  // budgets within [0.625, 2.5] of the mean, reported in the line and the stats.
-  r = run("render s.json -o a.exr --stats-json a.json " + cache +
-          "--set renderer.raymarch.msCache.layout=\\\"view\\\" --set renderer.raymarch.msCache.allocation=\\\"perceptual\\\"");
-  ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(r.err, "");
-  const nlohmann::json budget = stats("a.json")["ms_cache_budget"];
-  ASSERT_EQ(budget.size(), 2u);
-  EXPECT_GE(budget[0].get<int>(), 3);
-  EXPECT_LE(budget[1].get<int>(), 10);
-  EXPECT_LE(budget[0].get<int>(), budget[1].get<int>());
-  EXPECT_EQ(stats("a.json")["ms_cache_paths"], 4);
-  EXPECT_NE(r.out.find("columns x rows x slices, a mean of 4 paths per node, filtered (sigma 1 columns, tolerance 3 "
-                       "standard errors, twiced), allocated perceptually ("),
-            std::string::npos)
-      << r.out;
   r = run("render s.json -o g.exr --stats-json g.json " + cache + "--set renderer.raymarch.msCache.layout=\\\"grid\\\"");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err,
@@ -305,28 +289,6 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   s = stats("g.json");
   EXPECT_EQ(s["ms_cache_filter"], 0.0);
   EXPECT_EQ(s["ms_cache_filter_tolerance"], 0.0);
-}
-
-// The guide is reported with its share (the text line and the stats), and 0 without it.
-TEST_F(LightCacheCli, TheGuideIsReported) {
-  const std::string cache =
-      "--set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.paths=4 "
-      "--set renderer.raymarch.msCache.layout=\\\"view\\\" --set renderer.raymarch.msCache.tile=4 "
-      "--set renderer.raymarch.msCache.filter=0 ";
-  RunResult r =
-      run("render s.json -o v.exr --stats-json v.json " + cache + "--set renderer.raymarch.msCache.guide=0.25");
-  ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(r.err, "");
-  EXPECT_EQ(stats("v.json")["ms_cache_guide"], 0.25);
-  EXPECT_NE(r.out.find("multiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, guided towards "
-                       "the lights (share 0.25) in "),
-            std::string::npos)
-      << r.out;
-  r = run("render s.json -o u.exr --stats-json u.json " + cache);
-  ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(stats("u.json")["ms_cache_guide"], 0.0);
-  EXPECT_EQ(r.out.find("guided"), std::string::npos) << r.out;
-  EXPECT_NE(readExr((dir_ / "v.exr").string()).rgb, readExr((dir_ / "u.exr").string()).rgb);
 }
 
 // Moving the point light is a new cache: the image changes where its light reaches the cloud.
@@ -395,15 +357,6 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
       {"renderer.raymarch.msCache.direct=true --set renderer.raymarch.msCache.layout=\\\"grid\\\"",
        "narval: s.json: renderer.raymarch.msCache.direct: needs closure \"camera\" or layout \"view\" (a node must "
        "hold the light scattered towards the camera)\n"},
-      {"renderer.raymarch.msCache.guide=-0.1",
-       "narval: s.json: renderer.raymarch.msCache.guide: must be non-negative, got -0.1\n"},
-      {"renderer.raymarch.msCache.guide=1 --set renderer.raymarch.msCache.layout=\\\"view\\\"",
-       "narval: s.json: renderer.raymarch.msCache.guide: must be below 1 (the phase function's share covers every "
-       "direction), got 1\n"},
-      {"renderer.raymarch.msCache.guide=0.15 --set renderer.raymarch.msCache.layout=\\\"grid\\\" "
-       "--set renderer.raymarch.msCache.direct=false",
-       "narval: s.json: renderer.raymarch.msCache.guide: needs closure \"camera\" or layout \"view\" (the uniform "
-       "closures draw no phase-function directions to guide)\n"},
       {"renderer.raymarch.msCache.tile=0", "narval: s.json: renderer.raymarch.msCache.tile: must be at least 1, got 0\n"},
       {"renderer.raymarch.msCache.tile=\\\"big\\\"",
        "narval: s.json: renderer.raymarch.msCache.tile: expected \"auto\" or pixels per column side, got \"big\"\n"},
@@ -422,8 +375,6 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "residual)\n"},
       {"renderer.raymarch.msCache.filterTwicing=1",
        "narval: s.json: renderer.raymarch.msCache.filterTwicing: expected a boolean, got number\n"},
-      {"renderer.raymarch.msCache.allocation=\\\"spread\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",
-       "narval: s.json: renderer.raymarch.msCache.allocation: unknown value \"spread\" (allowed: even, perceptual)\n"},
       {"renderer.raymarch.msCache.filter=\\\"wide\\\"",
        "narval: s.json: renderer.raymarch.msCache.filter: expected a number, got string\n"},
       {"renderer.raymarch.msCache.closure=\\\"hg\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",

@@ -95,14 +95,14 @@ TEST(MsCacheMotion, AnOrbitDrawsTheReprojectionThenEndsAsTheCacheBuiltThere) {
   const size_t floats = nodeGridCount(params.grid) * MS_CACHE_STRIDE;
   const auto whole = [&](DeviceMsCache& cache, DeviceSceneBuffers& dev) {
     for (int calls = 0; (cache.paths() < 24 || cache.filterPending() || cache.reprojected()) && calls < 100000; ++calls)
-      cache.refine(runtime(), dev, params, 24, 32, "lit_box.json", {}, 0.01);
+      cache.refine(runtime(), dev, params, 24, 32, "lit_box.json", 0.01);
   };
   DeviceMsCache cache;
   whole(cache, devBefore);
   EXPECT_FALSE(cache.reprojected());
   const std::vector<float> drawnBefore = readBuffer(cache.buffer(), floats);
 
-  cache.refine(runtime(), devAfter, params, 24, 32, "lit_box.json", {}, 0.001);
+  cache.refine(runtime(), devAfter, params, 24, 32, "lit_box.json", 0.001);
   ASSERT_TRUE(cache.reprojected());
   EXPECT_EQ(cache.paths(), 0);
   const std::vector<float> prior = readBuffer(cache.buffer(), floats), placed = readBuffer(cache.means(), floats);

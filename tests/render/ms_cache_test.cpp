@@ -11,7 +11,6 @@
 
 #include "render/device_ms_cache.h"
 #include "render/device_scene.h"
-#include "render/ms_cache_allocation.h"
 #include "render/node_grid_layout.h"
 #include "render/realtime_renderer.h"
 #include "render_fixture.h"
@@ -203,7 +202,7 @@ BudgetedCache budgetedCache(const Scene& scene, int paths, double budgetMs) {
   BudgetedCache out;
   double done = 0;
   do {
-    cache.refine(runtime(), dev, params, paths, 32, "lit_box.json", {}, budgetMs);
+    cache.refine(runtime(), dev, params, paths, 32, "lit_box.json", budgetMs);
     EXPECT_GE(cache.pathsDone(), done);  // never backwards
     done = cache.pathsDone();
     ++out.calls;
@@ -254,9 +253,9 @@ TEST(MsCache, AMovedLightIsRefreshedProgressivelyToTheCacheBuiltThere) {
   DeviceSceneBuffers devBefore(runtime(), before, nullptr), devAfter(runtime(), after, nullptr);
   const ms_cache_params params = realtimeParams(before, devBefore.scene).msCache;
   DeviceMsCache cache;
-  while (cache.paths() < 24) cache.refine(runtime(), devBefore, params, 24, 32, "before", {}, 0.01);
+  while (cache.paths() < 24) cache.refine(runtime(), devBefore, params, 24, 32, "before", 0.01);
   const std::vector<float> old = runningMeans(cache, params);
-  cache.refine(runtime(), devAfter, params, 24, 32, "after", {}, 0.01);
+  cache.refine(runtime(), devAfter, params, 24, 32, "after", 0.01);
   EXPECT_EQ(cache.rebuilds(), 2);
   const std::vector<float> partial = runningMeans(cache, params);
   int kept = 0, refreshed = 0;
@@ -268,61 +267,10 @@ TEST(MsCache, AMovedLightIsRefreshedProgressivelyToTheCacheBuiltThere) {
   EXPECT_GT(kept, 0);
   EXPECT_GT(refreshed, 0);
   for (int calls = 0; cache.paths() < 24 && calls < 100000; ++calls)
-    cache.refine(runtime(), devAfter, params, 24, 32, "after", {}, 0.01);
+    cache.refine(runtime(), devAfter, params, 24, 32, "after", 0.01);
   const std::vector<float> refreshedMeans = runningMeans(cache, params), scratch = cacheAfter(after, 24, 32);
   for (size_t i = 0; i < scratch.size(); ++i)
     ASSERT_EQ(refreshedMeans[i], scratch[i]) << "node " << i / MS_CACHE_STRIDE << ", slot " << i % MS_CACHE_STRIDE;
-}
-
-// The perceptual allocation (render/ms_cache_allocation.h) on the lit box's view cache (tile 1, 8x8
-// columns, a mean of 48 paths): every node first takes the pilot (12), then its column's budget.
-// Built in one call and as a viewer builds it (one launch of 5 mean paths a call, until paths()
-// reaches the mean), the nodes are the same bits; each node holds exactly its budget of paths, the
-// budgets lie within [0.625, 2.5] of the mean and average it within rounding, and they differ (the
-// allocation is not the even share here).
-std::vector<float> allocatedCacheAfter(const Scene& scene, int mean, int perLaunch, bool progressive) {
-  DeviceSceneBuffers dev(runtime(), scene, nullptr);
-  const ms_cache_params params = realtimeParams(scene, dev.scene).msCache;
-  MsCacheAllocation allocation;
-  allocation.perceptual = true;
-  allocation.meanPaths = mean;
-  allocation.toneMapping = scene.renderer.toneMapping;
-  DeviceMsCache cache;
-  if (!progressive) cache.refine(runtime(), dev, params, mean, perLaunch, "lit_box.json", allocation);
-  for (int calls = 0; progressive && cache.paths() < mean; ++calls) {
-    cache.refine(runtime(), dev, params, std::min(mean, cache.paths() + perLaunch), perLaunch, "lit_box.json",
-                 allocation);
-    EXPECT_LT(calls, 4 * mean);  // progress at every call
-    if (calls >= 4 * mean) break;
-  }
-  EXPECT_EQ(cache.paths(), mean);
-  EXPECT_LT(cache.budgetMin(), cache.budgetMax());
-  return runningMeans(cache, params);
-}
-
-TEST(MsCache, PerceptualAllocationSpendsEachColumnsBudgetInAnyLaunchSize) {
-  Scene scene = litBox();
-  scene.renderer.raymarch.msCache.layout = MsCacheLayout::View;
-  scene.renderer.raymarch.msCache.tile = 1;
-  const int mean = 48;
-  const std::vector<float> one = allocatedCacheAfter(scene, mean, 48, false);
-  const std::vector<float> many = allocatedCacheAfter(scene, mean, 5, true);
-  EXPECT_EQ(one, many);
-  const size_t columns = 64;
-  double sum = 0;
-  int n = 0;
-  for (size_t col = 0; col < columns; ++col) {
-    const float* first = &one[col * MS_CACHE_STRIDE];
-    if (first[MS_VIEW_TAU] < 0.0f) continue;
-    const float budget = first[MS_VIEW_BUDGET];
-    EXPECT_GE(budget, 30.0f);   // 0.625 · 48
-    EXPECT_LE(budget, 120.0f);  // 2.5 · 48
-    for (int s = 0; s < 8; ++s) ASSERT_EQ(one[(size_t(s) * columns + col) * MS_CACHE_STRIDE + 3], budget);
-    sum += budget;
-    ++n;
-  }
-  ASSERT_GT(n, 0);
-  EXPECT_NEAR(sum / n, mean, 0.5);
 }
 
 // The view layout's filter (ms_cache_filter.h) on the device is the shared code's on the host,
@@ -567,7 +515,6 @@ struct LitBoxCase {
 struct LitBoxCheck {
   double worstRatio = 0, worstBound = 0, otherOutside = 0;
   size_t tiles = 0;
-  int budgetMin = 0, budgetMax = 0;  // the coarse cache's perceptual allocation, seed 1 (0, 0: even)
 };
 
 // Checks every case against the shared reference, printing what each measured and asserting its
@@ -594,10 +541,9 @@ std::vector<LitBoxCheck> checkLitBox(const std::string& phase, const std::vector
       "multipleScattering": ")" + ms + R"(", "msCache": {"paths": )" + std::to_string(paths) +
            R"(, "pathsPerLaunch": 512, )" + cache + unnamed + "}}}";
   };
-  auto realtime = [&](const std::string& renderer, uint32_t seed, LitBoxCheck* allocation = nullptr) {
+  auto realtime = [&](const std::string& renderer, uint32_t seed) {
     const RenderResult r = renderRealtime(runtime(), scene(renderer, seed), grid, 1, RenderOptions{});
     EXPECT_EQ(r.stats.status, 0u);
-    if (allocation) allocation->budgetMin = r.stats.msCache.budgetMin, allocation->budgetMax = r.stats.msCache.budgetMax;
     return r.image;
   };
   const RenderResult ptA = render(scene(pt, 1), grid), ptB = render(scene(pt, 2), grid);
@@ -609,7 +555,7 @@ std::vector<LitBoxCheck> checkLitBox(const std::string& phase, const std::vector
   for (const LitBoxCase& c : cases) {
     SCOPED_TRACE(c.what);
     LitBoxCheck out;
-    const ImageRGB coarseA = realtime(rm(64, "cache", c.coarse, 2048), 1, &out),
+    const ImageRGB coarseA = realtime(rm(64, "cache", c.coarse, 2048), 1),
                    coarseB = realtime(rm(64, "cache", c.coarse, 2048), 2);
     const ImageRGB fineA = realtime(rm(128, "cache", c.fine, 512), 1), fineB = realtime(rm(128, "cache", c.fine, 512), 2);
     const std::vector<double> coarse = tileMeans(averaged(coarseA, coarseB));
@@ -699,33 +645,13 @@ TEST(MsCache, CameraAimedCachesMatchThePathTracerForAForwardPhaseFunction) {
 // The view layout holding the direct light of a 1x1 rectangle light facing the box (met by the
 // paths' first segments and by the shadow rays, both weighted by MIS), HG g = 0.8; the linear
 // closure, whose single scattering the march computes, falls outside the bound on every tile
-// channel (measured 48 of 48). Three ways of spending the paths, each with the same expectation:
-// - evenly (widest bound 14.0%, asserted ≤ 30%);
-// - the perceptual allocation (render/ms_cache_allocation.h), which gives each column its own number
-//   of paths from its neighbours' pilot and never its own, so each node's mean keeps its expectation;
-//   its budgets are asserted to differ (measured 1280–2688 about the mean of 2048), so the allocation
-//   is in play;
-// - guided (msCache.guide, kernels/shared/phase_guide.h): half of each path's first directions drawn
-//   about the direction to the light instead of by the phase function, with the weight p/pdf and the
-//   mixture's pdf in both MIS weights, every weight in play. A share of 0.5, twice the picks', to make
-//   a wrong weight show.
-TEST(MsCache, ViewLayoutHoldingARectangleLightMatchesThePathTracerHoweverItSpendsItsPaths) {
-  const std::vector<LitBoxCheck> checks = checkLitBox(
-      R"("phaseFunction": "hg", "g": 0.8)",
-      {{"HG 0.8, rectangle light, layout view with the direct light",
-        R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
-        R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", 0.3},
-       {"HG 0.8, rectangle light, layout view with the direct light, allocated",
-        R"("layout": "view", "tile": 2, "slices": 8, "direct": true, "allocation": "perceptual")",
-        R"("layout": "view", "tile": 1, "slices": 16, "direct": true, "allocation": "perceptual")", 0.3},
-       {"HG 0.8, rectangle light, layout view with the direct light, guided",
-        R"("layout": "view", "tile": 2, "slices": 8, "direct": true, "guide": 0.5)",
-        R"("layout": "view", "tile": 1, "slices": 16, "direct": true, "guide": 0.5)", 0.3}},
-      "cache", R"("resolution": 8)", "the linear closure", 0.5, kLitBoxPanel);
-  ASSERT_EQ(checks.size(), 3u);
-  std::printf("[ ms cache ] lit box, allocated: budgets %d-%d paths a column\n", checks[1].budgetMin,
-              checks[1].budgetMax);
-  EXPECT_LT(checks[1].budgetMin, checks[1].budgetMax);
+// channel (measured 48 of 48). Widest bound 14.0% (asserted ≤ 30%).
+TEST(MsCache, ViewLayoutHoldingARectangleLightMatchesThePathTracer) {
+  checkLitBox(R"("phaseFunction": "hg", "g": 0.8)",
+              {{"HG 0.8, rectangle light, layout view with the direct light",
+                R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
+                R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", 0.3}},
+              "cache", R"("resolution": 8)", "the linear closure", 0.5, kLitBoxPanel);
 }
 
 // The same in a heterogeneous medium: a 32³ grid filling the box whose density rises eightfold

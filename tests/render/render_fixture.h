@@ -78,7 +78,7 @@ inline RenderResult renderAlgorithm(const Scene& scene, SceneGrids grid = {}) {
 // lights and the HG closure; "raymarch+ms-cache-camera" the same cache with its paths aimed at the
 // camera; "raymarch+ms-cache-view" the view layout, columns of 2x2 pixels, 4 slices, with the
 // rectangles' shadows weighted by the phase; "raymarch+ms-cache-direct" the same holding the
-// lights' unscattered light too, no light loop, its paths allocated perceptually over the columns)
+// lights' unscattered light too, no light loop)
 // and the Lobe Estimator as Eq. 7 ("lobe+eq7") and corrected (its phase exact as well).
 inline const char* const kHardCaseRenderers[] = {"pathtrace",         "raymarch",
                                                  "raymarch+octaves",  "raymarch+ms-cache",
@@ -107,7 +107,6 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGr
       scene.renderer.raymarch.msCache.slices = 4;
       scene.renderer.raymarch.shadowWeighting = ShadowWeighting::Phase;
       scene.renderer.raymarch.msCache.direct = renderer == "raymarch+ms-cache-direct";
-      if (renderer == "raymarch+ms-cache-direct") scene.renderer.raymarch.msCache.allocation = MsCacheAllocationKind::Perceptual;
     }
   } else if (renderer == "raymarch") {  // the dissertation's march: single scattering
     scene.renderer.algorithm = Algorithm::Raymarch;

@@ -133,10 +133,10 @@ TEST(MsCacheReproject, ThePriorFadesAsTheNodesOwnPathsComeIn) {
   fresh[3] = 40.0f;
   ms_view_blend_node(prior, fresh, 40, out);
   for (int i = 0; i < MS_CACHE_STRIDE; ++i) EXPECT_EQ(out[i], fresh[i]) << "slot " << i;
-  fresh[3] = 10.0f;
-  fresh[MS_VIEW_BUDGET] = 20.0f;  // a column's own budget (the perceptual allocation) is its N
+  fresh[3] = 10.0f;  // the prior's weight m = 40·(1 − 10/40) = 30
   ms_view_blend_node(prior, fresh, 40, out);
-  EXPECT_FLOAT_EQ(out[0], (20.0f * 3.0f + 10.0f / 3.0f) / 30.0f);
+  EXPECT_FLOAT_EQ(out[0], (30.0f * 3.0f + 10.0f / 3.0f) / 40.0f);
+  EXPECT_FLOAT_EQ(out[3], 40.0f);
   fresh[MS_VIEW_TAU] = -1.0f;
   ms_view_blend_node(prior, fresh, 40, out);
   for (int i = 0; i < MS_CACHE_STRIDE; ++i) EXPECT_EQ(out[i], fresh[i]) << "slot " << i;
