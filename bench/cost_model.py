@@ -98,15 +98,9 @@ def measure():
                 points = series(algorithm, factor, meta)
                 print("  %s %s (%d points; load %s)" % (algorithm, factor, len(points), b.load_average()),
                       file=sys.stderr)
-                if algorithm == "pathtrace":
-                    for q in points:
-                        run(raw, algorithm, factor, q[0], 0, q[1], counters=True)
-                for q in points:
-                    run(raw, algorithm, factor, q[0], -2, q[2])
-                run(raw, algorithm, factor, points[0][0], -1, points[0][1])
-                for rep in range(1, meta["reps"] + 1):
-                    for q in points:
-                        run(raw, algorithm, factor, q[0], rep, q[1])
+                for rep in ([0] if algorithm == "pathtrace" else []) + [-2, -1] + list(range(1, meta["reps"] + 1)):
+                    for x, opts, startup in points[:1] if rep == -1 else points:
+                        run(raw, algorithm, factor, x, rep, startup if rep == -2 else opts, counters=rep == 0)
     meta.update(seconds=time.monotonic() - start, loadavg_end=b.load_average())
     (out / "meta.json").write_text(json.dumps(meta, indent=1))
     report()

@@ -46,11 +46,8 @@ def run():
                                                "--set", "renderer.storage=" + storage, "--stats-json", stats)))
     print("cloud %d^3 (seed %d), file %.1f MiB; image %s, pathtrace %d spp, raymarch %d frames" % (
         a.resolution, a.seed, vdb.stat().st_size / 2 ** 20, a.image, a.spp, a.frames))
-    for name, _, (_, _, err) in steps:
-        for line in err.splitlines():
-            if "warning" in line:
-                print("  %s: %s" % (name, line.strip()))
-    print()
+    print("".join("  %s: %s\n" % (name, line.strip()) for name, _, (_, _, err) in steps
+                  for line in err.splitlines() if "warning" in line))
     b.header("step", "storage", "wall s", "kernel s", "peak RSS", "bricks occupied / total", "grid on device")
     for name, stats_path, (wall, rss, _) in steps:
         storage = kernel = bricks = grid = ""

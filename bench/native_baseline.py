@@ -81,8 +81,7 @@ def measure_case(scene, algorithm, resolution, spp):
     cells = [scene, algorithm, size, "%.3f" % m(kernel), "%.3f" % m(wall), "%.3f" % m(times["native"]),
              "**%.2f**" % (m(kernel) / m(times["native"])), "%.2f" % (min(kernel) / min(times["native"])),
              "%.2f" % ((m(cpu_pocl) - base_pocl) / (m(cpu_native) - base_native))]
-    for v in variants[1:]:
-        cells += ["%.3f" % m(times[v]), "%.2f" % (m(kernel) / m(times[v]))]
+    cells += [x for v in variants[1:] for x in ("%.3f" % m(times[v]), "%.2f" % (m(kernel) / m(times[v])))]
     cells.append(", ".join("%.2f" % (x / y) for x, y in zip(kernel, times["native"])))
     b.row(*cells, "%.1f%%" % compared["compare"]["pixels_bitwise_identical_pct"], "%.2g" % de)
 

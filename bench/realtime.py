@@ -113,8 +113,7 @@ def tuning_row(scene, resolution, algorithm, label, name, sets, reference=None, 
     """One row: NAME rendered with the --set values, against REFERENCE (itself: 0). label may name the
     light cache's cells, {cells}; build: the column's text, or True for the cache's build ms."""
     s = render(scene, algorithm, resolution, name, *sets)
-    de, jnd = delta(reference, name) if reference else (0, 0)
-    error = ["%.3f" % de, "%.2f%%" % jnd] if reference else ["0", "0%"]
+    error = [f % v for f, v in zip(("%.3f", "%.2f%%"), delta(reference, name))] if reference else ["0", "0%"]
     cells = max(s["light_cache_cells"])
     build = "%.1f" % s["light_cache_ms"] if build is True else build
     b.row(algorithm, label.format(cells=cells), "%.1f" % s["ms_per_frame"]["median"], build, *error)
@@ -159,8 +158,7 @@ def view_cache(tile, paths, sigma, tolerance, **more):
 CACHE_PICKS = {"cloud": view_cache(1, 100, 1.5, 2), "smoke": view_cache(1, 100, 1.5, 2),
                "disney_cloud": view_cache(1, 136, 1.5, 2, filterTwicing=True),
                "disney_cloud_front": view_cache(2, 480, 2, 0.5)}
-METHODS = [("raymarch, single scattering", ["--algorithm", "raymarch", "--set",
-                                            'renderer.raymarch.multipleScattering="none"']),
+METHODS = [("raymarch, single scattering", ["--algorithm", "raymarch", "--set", b.MARCH]),
            ("raymarch + multiple-scattering cache", None),
            ("lobe, Eq. 7", ["--algorithm", "lobe", "--set", 'renderer.lobe.variant="eq7"']),
            ("lobe, corrected", ["--algorithm", "lobe", "--set", 'renderer.lobe.variant="corrected"'])]

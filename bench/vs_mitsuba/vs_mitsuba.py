@@ -20,11 +20,12 @@ import signal
 import struct
 import sys
 import time
+from pathlib import Path
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.dirname(HERE))  # bench/: what the bench scripts share
-from scene_env import montage, need_pillow, resolved_scene, run_json, run_narval, volume_path  # noqa: E402
+from scene_env import montage, need_pillow, options, resolved_scene, run_json, run_narval, volume_path  # noqa: E402
 WORK_DIR = os.path.join(REPO, "build", "vs_mitsuba")
 # compare disagrees when a channel's image-mean |z| exceeds Z_LIMIT (two-sided 6.3e-5 per channel) or
 # the 4x4 tiles' chi^2 has an upper tail below CHI2_P_LIMIT: about 3 false alarms in 10^4 in all.
@@ -50,8 +51,7 @@ def ensure_environment():
         return "no Mitsuba environment at %s (run bench/vs_mitsuba/setup.sh)" % venv
     llvm_file = os.path.join(venv, "drjit_libllvm_path")  # the libLLVM setup.sh found to work
     if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(llvm_file):
-        with open(llvm_file) as f:
-            os.environ["DRJIT_LIBLLVM_PATH"] = f.read().strip()
+        os.environ["DRJIT_LIBLLVM_PATH"] = Path(llvm_file).read_text().strip()
     if os.path.realpath(sys.prefix) != os.path.realpath(venv) and not os.environ.get("NARVAL_VS_MITSUBA_EXEC"):
         os.environ["NARVAL_VS_MITSUBA_EXEC"] = "1"  # once: no exec loop
         os.execv(py, [py, os.path.abspath(__file__)] + sys.argv[1:])
@@ -72,8 +72,6 @@ def mitsuba():
     dr.set_thread_count(int(os.environ.get("NARVAL_MITSUBA_THREADS", "2")))
     return mi
 
-
-# ---- narval's scene, as `narval scene --resolved` writes it ----------------------------------------
 
 def load_narval_scene(narval, path, resolution=None, overrides=()):
     """What the path tracer uses, as narval resolves it: materials by name (a volume's grid path found
@@ -98,14 +96,12 @@ def load_narval_scene(narval, path, resolution=None, overrides=()):
             "width": r["resolution"][0], "height": r["resolution"][1], "spp": r["spp"], "bounces": r["bounces"]}
 
 
-# ---- grids, read as narval reads them (host/volume/vdb_io.cpp, vol_io.cpp) --------------------------
-
 def read_grid(path, grid_name):
-    """(data[x, y, z] float32, index_to_world 3x4). narval's voxel i covers [i, i+1]; a .vdb grid is its
-    active bounding box copied densely, placed by the file's affine map shifted by bbox.min - 0.5."""
+    """(data[x, y, z] float32, index_to_world 3x4), read as narval reads them (host/volume/vdb_io.cpp,
+    vol_io.cpp). narval's voxel i covers [i, i+1]; a .vdb grid is its active bounding box copied densely,
+    placed by the file's affine map shifted by bbox.min - 0.5."""
     if path.lower().endswith(".vol"):
-        with open(path) as f:  # the dissertation's text .vol: "X Y Z", then X*Y*Z floats, x fastest
-            tokens = f.read().split()
+        tokens = Path(path).read_text().split()  # the dissertation's text .vol: "X Y Z", then X*Y*Z floats, x fastest
         nx, ny, nz = (int(t) for t in tokens[:3])
         values = np.array(tokens[3:], dtype=np.float64).astype(np.float32)
         if values.size != nx * ny * nz:
@@ -127,8 +123,6 @@ def read_grid(path, grid_name):
         raise ValueError("%s: densities must be finite and >= 0 (narval refuses this grid)" % path)
     return data, m
 
-
-# ---- translate (host/render/scene_upload.cpp; README.md's table) ------------------------------------
 
 def rotation_matrix(deg):
     """narval's R = Rz . Ry . Rx (X first), angles in degrees, right-handed."""
@@ -154,7 +148,7 @@ def rgb(v, unbounded=False):
 
 def translate_scene(scene, out_dir):
     """Writes OUT_DIR/mitsuba_scene.json (mi.load_dict's dict, every to_world a 4x4 list) and the grid
-    as a Mitsuba .vol; the dict."""
+    as a Mitsuba .vol; the dict. The conventions matched: host/render/scene_upload.cpp, README.md's table."""
     os.makedirs(out_dir, exist_ok=True)
     # max_depth counts the camera vertex: `bounces` scattering events, then the continuation ray's
     # emitter or background; Russian roulette is put out of reach.
@@ -172,8 +166,7 @@ def translate_scene(scene, out_dir):
     if any(c > 0 for c in scene["background"]):
         d["background"] = {"type": "constant", "radiance": rgb(scene["background"])}
     d["sensor"] = translate_camera(scene, medium_box)
-    with open(os.path.join(out_dir, "mitsuba_scene.json"), "w") as f:
-        json.dump(d, f, indent=1)
+    Path(out_dir, "mitsuba_scene.json").write_text(json.dumps(d, indent=1))
     return d
 
 
@@ -223,10 +216,8 @@ def translate_volume(p, mat, out_dir):
             padded, pad_box = data, affine(np.diag(dims), [0, 0, 0])
         if "half_voxel" in PERTURB:
             pad_box = affine(np.eye(3), [0.5, 0.5, 0.5]) @ pad_box
-        if grey:
-            values, scale = padded[..., None], density * float(k[0])
-        else:
-            values, scale = padded[..., None] * k.astype(np.float32)[None, None, None, :], density
+        values, scale = ((padded[..., None], density * float(k[0])) if grey
+                         else (padded[..., None] * k.astype(np.float32)[None, None, None, :], density))
         vol_path = os.path.join(out_dir, "density.vol")  # Mitsuba's binary .vol: x fastest, box [0,1]^3
         with open(vol_path, "wb") as f:
             f.write(b"VOL\x03" + struct.pack("<5i6f", 1, *values.shape, 0, 0, 0, 1, 1, 1))
@@ -255,9 +246,8 @@ def translate_camera(scene, medium_box):
     pos = np.array(c["position"])
     fwd = unit(np.array(c["lookAt"]) - pos)
     right = unit(np.cross(fwd, np.array(c["up"])))
-    m = np.eye(4)
     x = right if "mirror" in PERTURB else -right
-    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = x, np.cross(right, fwd), fwd, pos
+    m = affine(np.column_stack([x, np.cross(right, fwd), fwd]), pos)
     sensor = {"type": "perspective", "fov": c["vfov"], "fov_axis": "y", "to_world": m.tolist(),
               "near_clip": 1e-4, "far_clip": 1e7,  # near the first voxel: Mitsuba starts rays at the near plane
               "film": {"type": "hdrfilm", "width": scene["width"], "height": scene["height"],
@@ -279,8 +269,6 @@ def load_mitsuba_scene(scene, out_dir):
                          for k, x in v.items()} if isinstance(v, dict) else v
     return mitsuba().load_dict(objects(translate_scene(scene, out_dir)))
 
-
-# ---- rendering ---------------------------------------------------------------------------------------
 
 def render_mitsuba(mscene, spp, seed, timings=None):
     """Mitsuba's image (HxWx3) of spp samples per pixel, one wavefront of W*H*spp lanes. With `timings` (a
@@ -317,14 +305,11 @@ def render_narval(narval, scene_path, spp, seed, resolution, out_exr, extra_args
     run_narval(narval, ["render", scene_path, "--algorithm", "pathtrace", "--spp", spp, "--resolution",
                         "%dx%d" % resolution, "--seed", seed, "-o", out_exr, "-q", "--stats-json", stats_path]
                + list(extra_args))
-    with open(stats_path) as f:
-        st = json.load(f)
+    st = json.loads(Path(stats_path).read_text())
     if any(st.get("status", {}).values()):
         print("warning: narval status flags %s" % st["status"], file=sys.stderr)
     return st
 
-
-# ---- compare: statistics (README.md, "Statistics") ---------------------------------------------------
 
 def chi2_sf(x, k):
     """P(X > x) for X ~ chi^2 with k degrees of freedom: Q(k/2, x/2) by Q(a + 1, z) = Q(a, z) +
@@ -347,8 +332,8 @@ def region_stats(mean, var, sl):
 
 
 def compare_images(narval_imgs, mitsuba_imgs):
-    """z of the image-mean difference per channel, and chi^2 of the TILES x TILES tiles' mean
-    differences (one degree of freedom per tile that sees noise: q = the mean over RGB of z^2)."""
+    """z of the image-mean difference per channel, and chi^2 of the TILES x TILES tiles' mean differences
+    (one degree of freedom per tile that sees noise: q = the mean over RGB of z^2; README.md, "Statistics")."""
     # Per pixel, the mean over the K renders and the variance of that mean.
     per_pixel = lambda imgs: (imgs.mean(axis=0), imgs.var(axis=0, ddof=1) / imgs.shape[0])  # noqa: E731
     (mn, vn), (mm, vm) = (per_pixel(np.asarray(i, dtype=np.float64)) for i in (narval_imgs, mitsuba_imgs))
@@ -358,19 +343,18 @@ def compare_images(narval_imgs, mitsuba_imgs):
     z = [float(x) for x in np.where(se > 0, (mean_n - mean_m) / np.where(se > 0, se, 1), 0.0)]
     ys, xs = (np.linspace(0, n, TILES + 1).round().astype(int) for n in mn.shape[:2])
     chi2, dof, worst = 0.0, 0, None
-    for j in range(TILES):
-        for i in range(TILES):
-            sl = np.s_[ys[j]:ys[j + 1], xs[i]:xs[i + 1]]
-            if ys[j + 1] <= ys[j] or xs[i + 1] <= xs[i]:
-                continue
-            (tn, tvn), (tm, tvm) = region_stats(mn, vn, sl), region_stats(mm, vm, sl)
-            diff, var = tn - tm, tvn + tvm
-            tol2 = (NUMERIC_TOLERANCE * max(np.abs(tn).max(), np.abs(tm).max())) ** 2 + 1e-300
-            q, k = float(np.mean(diff ** 2 / (np.maximum(var, 0.0) + tol2))), int(np.any(var > tol2))
-            chi2, dof = chi2 + q, dof + k
-            if worst is None or q / max(k, 1) > worst["chi2"] / max(worst["dof"], 1):
-                tz = [float(d / s) if s > 0 else 0.0 for d, s in zip(diff, np.sqrt(var))]
-                worst = {"tile": [i, j], "chi2": q, "dof": k, "z": tz}
+    for j, i in np.ndindex(TILES, TILES):
+        sl = np.s_[ys[j]:ys[j + 1], xs[i]:xs[i + 1]]
+        if ys[j + 1] <= ys[j] or xs[i + 1] <= xs[i]:
+            continue
+        (tn, tvn), (tm, tvm) = region_stats(mn, vn, sl), region_stats(mm, vm, sl)
+        diff, var = tn - tm, tvn + tvm
+        tol2 = (NUMERIC_TOLERANCE * max(np.abs(tn).max(), np.abs(tm).max())) ** 2 + 1e-300
+        q, k = float(np.mean(diff ** 2 / (np.maximum(var, 0.0) + tol2))), int(np.any(var > tol2))
+        chi2, dof = chi2 + q, dof + k
+        if worst is None or q / max(k, 1) > worst["chi2"] / max(worst["dof"], 1):
+            tz = [float(d / s) if s > 0 else 0.0 for d, s in zip(diff, np.sqrt(var))]
+            worst = {"tile": [i, j], "chi2": q, "dof": k, "z": tz}
     p = chi2_sf(chi2, dof) if dof else 1.0
     return {"narval_mean": mean_n.tolist(), "mitsuba_mean": mean_m.tolist(),
             "narval_se": np.sqrt(var_n).tolist(), "mitsuba_se": np.sqrt(var_m).tolist(),
@@ -399,8 +383,7 @@ def run_compare(scene_path, spp, seeds, resolution, narval, out_dir, sets=(), se
     r.update({"scene": os.path.abspath(scene_path), "resolution": list(res), "spp": spp, "seeds": seeds,
               "seed_offset": seed_offset, "bounces": scene["bounces"], "sets": list(sets),
               "perturbations": sorted(PERTURB)})
-    with open(os.path.join(out_dir, "compare.json"), "w") as f:
-        json.dump(r, f, indent=1)
+    Path(out_dir, "compare.json").write_text(json.dumps(r, indent=1))
     perturbed = " (Mitsuba side perturbed: %s)" % ", ".join(r["perturbations"]) if r["perturbations"] else ""
     print("%s at %dx%d, %d spp x %d seeds, bounces %d%s: %s" % (os.path.basename(scene_path), *res, spp, seeds,
                                                                 scene["bounces"], perturbed,
@@ -415,8 +398,6 @@ def run_compare(scene_path, spp, seeds, resolution, narval, out_dir, sets=(), se
         " ".join("%+.1f" % x for x in wt["z"])))
     return r
 
-
-# ---- race (README.md, "Race") ------------------------------------------------------------------------
 
 def reference(scene_path, scene, res, ref_spp, narval):
     """A converged narval render in two halves of independent seeds, cached in WORK_DIR, keyed by the
@@ -448,6 +429,7 @@ def reference(scene_path, scene, res, ref_spp, narval):
 
 
 def run_race(args):
+    """narval's time against Mitsuba's at equal relMSE over the spp ladder (README.md, "Race"); race.json."""
     scene = load_narval_scene(args.narval, args.scene, args.resolution)
     res = (scene["width"], scene["height"])
     ladder = [int(x) for x in args.ladder.split(",")]
@@ -507,8 +489,7 @@ def run_race(args):
               "kernel_time_ratio_narval_over_mitsuba": ratio["rel_mse_x_kernel_seconds"],
               "interpolated": interpolated_ratios(summary), "date": time.strftime("%Y-%m-%d"),
               "raw": {k: {str(n): v for n, v in per.items()} for k, per in rows.items()}}
-    with open(os.path.join(out_dir, "race.json"), "w") as f:
-        json.dump(result, f, indent=1)
+    Path(out_dir, "race.json").write_text(json.dumps(result, indent=1))
     lines = ["| renderer | spp | seconds | kernel s | relMSE | relMSE x s |", "|---|---:|---:|---:|---:|---:|"]
     lines += ["| %s | %d | %.3f | %.3f | %.3g%s | %s |" % (
                   name, g["spp"], g["seconds"], g["kernel_seconds"], g["rel_mse"],
@@ -543,8 +524,6 @@ def interpolated_ratios(summary):
     return out
 
 
-# ---- picture -----------------------------------------------------------------------------------------
-
 def write_picture(compare_dir, out, diff_scale):
     """narval's mean image and Mitsuba's through narval's default display transform (Narkowicz's ACES fit,
     then the sRGB curve: kernels/shared/tonemap.h) and |narval - Mitsuba| x diff_scale (the sRGB curve)."""
@@ -555,8 +534,6 @@ def write_picture(compare_dir, out, diff_scale):
               np.clip(abs(narval - other) * diff_scale, 0, 1)]
     montage([[((srgb(x) * 255 + 0.5).astype(np.uint8), "") for x in panels]], out, gap=4)
 
-
-# ---- main ----------------------------------------------------------------------------
 
 def main():
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `... | head` ends quietly
@@ -571,15 +548,12 @@ def main():
         q.add_argument("--resolution", type=lambda t: tuple(int(v) for v in t.split("x")), default=size)
         q.add_argument("--out", help="output folder (default build/vs_mitsuba/%s_SCENE)" % q.prog.split()[-1])
     c.add_argument("--set", action="append", default=[], help="PATH=VALUE: a scene override, for both renderers")
-    c.add_argument("--spp", type=int, default=32)
-    c.add_argument("--seeds", type=int, default=4)
+    options(c, spp=32, seeds=4)
     c.add_argument("--seed-offset", type=int, default=0, help="narval seeds OFFSET+1.., Mitsuba 1000+OFFSET..")
     c.add_argument("--perturb", choices=PERTURBATIONS, action="append", default=[],
                    help="translate with this deliberate mistake (README.md)")
     r.add_argument("--narval-args", default="", help='options of narval\'s rung renders ("--majorant global")')
-    r.add_argument("--ladder", default="4,8,16,32,64,128")
-    r.add_argument("--reps", type=int, default=3)
-    r.add_argument("--ref-spp", type=int, default=8192)
+    options(r, ladder="4,8,16,32,64,128", reps=3, ref_spp=8192)
     pic = sub.add_parser("picture")
     pic.add_argument("compare_dir", help="a compare run's folder (build/vs_mitsuba/compare_SCENE)")
     pic.add_argument("out", help="the PNG to write")
@@ -599,18 +573,15 @@ def main():
     PERTURB.update(args.perturb)
     name = os.path.splitext(os.path.basename(args.scene))[0]
     out = args.out or os.path.join(WORK_DIR, "compare_" + name + "".join("_" + x for x in sorted(args.perturb)))
-    result = run_compare(args.scene, args.spp, args.seeds, args.resolution, args.narval, out,
-                         args.set, args.seed_offset)
-    return 0 if result["agree"] else 1
+    return 0 if run_compare(args.scene, args.spp, args.seeds, args.resolution, args.narval, out, args.set,
+                            args.seed_offset)["agree"] else 1
 
 
 if __name__ == "__main__":
     try:
         sys.exit(main())
-    except (ValueError, OSError, KeyError) as e:  # a scene or grid narval would refuse, a missing file
+    except (ValueError, OSError, KeyError, RuntimeError) as e:
         print("vs_mitsuba: error: %s%s" % (type(e).__name__ + ": " if isinstance(e, KeyError) else "", e),
               file=sys.stderr)
-        sys.exit(2)
-    except RuntimeError as e:  # narval or Mitsuba failed
-        print("vs_mitsuba: error: %s" % e, file=sys.stderr)
-        sys.exit(1)
+        # 2: a scene or grid narval would refuse, a missing file; 1: narval or Mitsuba failed
+        sys.exit(1 if isinstance(e, RuntimeError) else 2)
