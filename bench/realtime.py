@@ -145,19 +145,17 @@ def tuning():
                            ["renderer.lobe.viewSteps=%d" % steps], "view100")
 
 
-def view_cache(tile, paths, sigma, tolerance, **more):
+def view_cache(tile, paths, sigma, **more):
     """The view cache with the direct light and the filter (`more`: other msCache keys a pick names)."""
-    cache = dict(dict(layout="view", direct=True, tile=tile, paths=paths, filter=sigma, filterTolerance=tolerance,
-                      filterTwicing=False), **more)
+    cache = dict(dict(layout="view", direct=True, tile=tile, paths=paths, filter=sigma, filterTwicing=False), **more)
     return ["--algorithm", "raymarch", "--set", 'renderer.raymarch.multipleScattering="cache"',
             "--set", "renderer.raymarch.steps=30"] + [
         x for k, v in cache.items() for x in ("--set", "renderer.raymarch.msCache.%s=%s" % (k, json.dumps(v)))]
 
 
 # The cache's pick per scene (a build under 60 s on 2 CPU cores; bench/RESULTS.md).
-CACHE_PICKS = {"cloud": view_cache(1, 100, 1.5, 2), "smoke": view_cache(1, 100, 1.5, 2),
-               "disney_cloud": view_cache(1, 136, 1.5, 2, filterTwicing=True),
-               "disney_cloud_front": view_cache(2, 480, 2, 0.5)}
+CACHE_PICKS = {"cloud": view_cache(1, 100, 1.5), "smoke": view_cache(1, 100, 1.5),
+               "disney_cloud": view_cache(1, 136, 1.5, filterTwicing=True), "disney_cloud_front": view_cache(2, 480, 2)}
 METHODS = [("raymarch, single scattering", ["--algorithm", "raymarch", "--set", b.MARCH]),
            ("raymarch + multiple-scattering cache", None),
            ("lobe, Eq. 7", ["--algorithm", "lobe", "--set", 'renderer.lobe.variant="eq7"']),

@@ -33,8 +33,7 @@ METHODS = {  # algorithm, fixed settings, base parameters that differ from what 
     "raymarch-cache-direct": ("raymarch", dict(VIEW, **{"msCache.direct": True}),
                               {"msCache.tile": 2, "msCache.paths": 256}),
     "raymarch-cache-filtered": ("raymarch", dict(VIEW, **{"msCache.direct": True, "msCache.tile": 1}),
-                                {"msCache.paths": 160, "msCache.filter": 1, "msCache.filterTolerance": 2,
-                                 "msCache.filterTwicing": False}),
+                                {"msCache.paths": 160, "msCache.filter": 1, "msCache.filterTwicing": False}),
     "lobe-eq7": ("lobe", {"variant": "eq7"}, {}),
     "lobe-corrected": ("lobe", {"variant": "corrected"}, {}),
 }
@@ -51,7 +50,7 @@ FULL_SWEEPS = {
                             "msCache.paths": [64, 256, 1024], "shadowWeighting": ["area", "phase"]},
     "raymarch-cache-direct": {"msCache.tile": [2, 4], "msCache.slices": [4, 8], "msCache.paths": [128, 256, 512]},
     "raymarch-cache-filtered": {"msCache.paths": [40, 160], "msCache.filter": [1, 1.5, 2],
-                                "msCache.filterTolerance": [0.5, 2, 8], "msCache.filterTwicing": [False, True]},
+                                "msCache.filterTwicing": [False, True]},
     "lobe-eq7": {"lobePoints": [10, 30, 60], "depthFactor": [5, 20, 100], "shadowSteps": [25, 50, 100]},
     "lobe-corrected": {"lobePoints": [10, 30, 60], "lobeRadius": [0.3, 1, 3, 10], "viewSteps": [8, 16, 32],
                        "areaLightPhase": ["points", "exact"]},

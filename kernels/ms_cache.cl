@@ -44,7 +44,7 @@ __kernel void ms_cache_filter_view(ms_cache_params ms_cache, uint column_first, 
   if (get_global_id(0) >= column_count) return;
   const int column = (int)(column_first + get_global_id(0));
   if (column >= ms_cache.grid.nx * ms_cache.grid.ny) return;
-  ms_view_filter_column(&ms_cache.grid, cache, values, residual, column, ms_cache.filter, ms_cache.filter_tolerance,
+  ms_view_filter_column(&ms_cache.grid, cache, values, residual, column, ms_cache.filter, MS_VIEW_FILTER_TOLERANCE,
                         filtered + (size_t)column * MS_CACHE_STRIDE);
 }
 

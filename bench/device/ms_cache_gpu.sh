@@ -19,13 +19,13 @@ run() {
   timeout -s INT "$limit" "$N" "$@" 2>&1 | grep -v '^narval: progress' | tail -3
 }
 sc() { echo "$PWD/scenes/$1.json"; }
-view() {  # view TILE PATHS STEPS [FILTER TOLERANCE TWICING]: the view cache with the direct light
+view() {  # view TILE PATHS STEPS [FILTER TWICING]: the view cache with the direct light
   echo --algorithm raymarch --set 'renderer.raymarch.multipleScattering="cache"' \
     --set 'renderer.raymarch.msCache.layout="view"' --set renderer.raymarch.msCache.direct=true \
     --set renderer.raymarch.msCache.tile="$1" --set renderer.raymarch.msCache.paths=$((($2 + SCALE_PATHS - 1) / SCALE_PATHS)) \
     --set renderer.raymarch.steps="$3"
   shift 3  # the optional keys are set only where given (not "-"): else the scene's as narval resolves it
-  for k in filter filterTolerance filterTwicing; do
+  for k in filter filterTwicing; do
     [ $# -gt 0 ] || break
     [ "$1" = - ] || echo --set "renderer.raymarch.msCache.$k=$1"
     shift
@@ -46,17 +46,17 @@ hd_configs=(
   "disney_cloud_front front_t12_p1216_s30 12 1216 30"
   "disney_cloud_front front_t8_p1216_s30 8 1216 30"
   # With the filter (ms_cache_filter.h), at the 320x240 picks' settings and within a 100 ms build.
-  "cloud cloud_t4_p100_f1.5_k2 4 100 30 1.5 2"
-  "cloud cloud_t8_p100_f1_k2 8 100 30 1 2"
-  "smoke smoke_t8_p100_f1_k2 8 100 30 1 2"
-  "disney_cloud back_t4_p160_f1_k2 4 160 30 1 2"
-  "disney_cloud back_t4_p48_f1_k2 4 48 30 1 2"
-  "disney_cloud_front front_t8_p480_f2_k0.5 8 480 30 2 0.5"
-  "disney_cloud_front front_t8_p160_f2_k0.5 8 160 30 2 0.5"
+  "cloud cloud_t4_p100_f1.5 4 100 30 1.5"
+  "cloud cloud_t8_p100_f1 8 100 30 1"
+  "smoke smoke_t8_p100_f1 8 100 30 1"
+  "disney_cloud back_t4_p160_f1 4 160 30 1"
+  "disney_cloud back_t4_p48_f1 4 48 30 1"
+  "disney_cloud_front front_t8_p480_f2 8 480 30 2"
+  "disney_cloud_front front_t8_p160_f2 8 160 30 2"
   # The back-lit Disney cloud's 320x240 pick, twiced, at 4x the tile, and with fewer paths for a
   # 100 ms build.
-  "disney_cloud back_t4_p136_f1.5_k2_twiced 4 136 30 1.5 2 true"
-  "disney_cloud back_t4_p48_f1.5_k2_twiced 4 48 30 1.5 2 true"
+  "disney_cloud back_t4_p136_f1.5_twiced 4 136 30 1.5 true"
+  "disney_cloud back_t4_p48_f1.5_twiced 4 48 30 1.5 true"
 )
 stage 1 && stamp "1. real-time picks at $HD_RES"
 stage 1 && for c in "${hd_configs[@]}"; do
@@ -75,8 +75,8 @@ stage 3 && stamp "3. 320x240 caches with many paths"
 lo_configs=(
   "disney_cloud back_t2_p8192 2 8192"
   "disney_cloud back_t1_p4096 1 4096"
-  "disney_cloud back_t1_p136_f1.5_k2_twiced 1 136 1.5 2 true"
-  "disney_cloud_front front_t2_p480_f2_k0.5 2 480 2 0.5"
+  "disney_cloud back_t1_p136_f1.5_twiced 1 136 1.5 true"
+  "disney_cloud_front front_t2_p480_f2 2 480 2"
   "disney_cloud_front front_t3_p16384 3 16384"
   "disney_cloud_front front_t2_p8192 2 8192"
 )

@@ -295,8 +295,7 @@ void DeviceMsCache::addPaths(ClRuntime& rt, const DeviceSceneBuffers& dev, const
 // slice by column slice, then swapped to the front that the march reads: a budgeted refine never
 // shows a half-filtered copy, and until the first is done the march reads the running means.
 void DeviceMsCache::filter(ClRuntime& rt, const ms_cache_params& params) {
-  const std::string key = std::to_string(paths_) + "/" + rawBytes(params.filter) +
-                          rawBytes(params.filter_tolerance) + (twicingOn_ ? "/twiced" : "");
+  const std::string key = std::to_string(paths_) + "/" + rawBytes(params.filter) + (twicingOn_ ? "/twiced" : "");
   if (filterPass_ == 0) {
     if (key == filteredKey_ || paths_ == 0) return;  // nothing to filter before the first sweep
     filterPass_ = 1;

@@ -75,7 +75,6 @@ ms_cache_params msCacheParams(const MsCacheSettings& mc, int tile, bool on, cons
         p.grid.nz = mc.slices;
       }
       p.filter = mc.filter;
-      p.filter_tolerance = mc.filterTolerance;
       p.filter_twicing = mc.filter > 0 && mc.filterTwicing;
       break;
   }

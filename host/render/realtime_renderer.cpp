@@ -151,7 +151,6 @@ RenderResult RealtimeRenderer::result() {
     ms.cells[1] = mc.grid.ny;
     ms.cells[2] = mc.grid.nz;
     ms.filter = mc.filter;
-    ms.filterTolerance = mc.filter > 0 ? mc.filter_tolerance : 0;
     ms.filterTwicing = mc.filter_twicing != 0;
   } else {
     nodeGridCells(mc.grid, ms.cells);

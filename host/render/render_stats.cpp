@@ -39,7 +39,6 @@ void addJson(nlohmann::json& j, const MsCacheStats& c) {
   j["ms_cache_builds"] = c.builds;
   j["ms_cache_ms"] = c.ms;
   j["ms_cache_filter"] = c.filter;
-  j["ms_cache_filter_tolerance"] = c.filterTolerance;
   j["ms_cache_filter_twicing"] = c.filterTwicing;
 }
 
@@ -94,7 +93,7 @@ std::string describe(const MsCacheStats& c) {
        << (c.view ? " columns x rows x slices, " : " cells, ") << c.paths << " paths per node";
   if (c.progress < 1) line << " (" << int(c.progress * 100) << "% of the paths asked for)";
   if (c.filter > 0)
-    line << ", filtered (sigma " << c.filter << " columns, tolerance " << c.filterTolerance << " standard errors"
+    line << ", filtered (sigma " << c.filter << " columns"
          << (c.filterTwicing ? ", twiced" : "") << ")";
   line << " in " << c.ms << " ms (not in the frame times)\n";
   return line.str();

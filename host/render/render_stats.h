@@ -40,15 +40,14 @@ struct LightCacheStats {
 
 // The ray marcher's multiple-scattering cache (render/device_ms_cache.h): cells per axis (0 0 0:
 // off; the view layout: columns, rows and slices), paths per node, times it was started (1), its
-// build time apart from the frames; the view layout's filter (σ_s in columns, 0: off; its tolerance
-// k; twicing).
+// build time apart from the frames; the view layout's filter (σ_s in columns, 0: off; twicing).
 struct MsCacheStats {
   int cells[3] = {0, 0, 0};
   bool view = false;
   int paths = 0, builds = 0;
   double progress = 0;  // the share of its paths built (below 1 while a budgeted build is under way)
   double ms = 0;
-  float filter = 0, filterTolerance = 0;
+  float filter = 0;
   bool filterTwicing = false;
 };
 

@@ -148,10 +148,6 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   s.filter = readNonNegative(mc, "filter", s.filter);
   if (s.filter > 8) ctx.fail(mc.keyOf("filter"), "must be at most 8 (columns), got " + formatNumber(s.filter));
   mc.noteRange("filter", "[0, 8]");
-  s.filterTolerance = mc.getFloat("filterTolerance", s.filterTolerance);
-  mc.noteRange("filterTolerance", "> 0");
-  if (!(s.filterTolerance > 0))
-    ctx.fail(mc.keyOf("filterTolerance"), "must be positive, got " + formatNumber(s.filterTolerance));
   s.filterTwicing = mc.getBool("filterTwicing", s.filter > 0);  // on wherever the filter is (bench/RESULTS.md)
   if (s.filterTwicing && view && !(s.filter > 0))
     ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
@@ -159,7 +155,7 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   s.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.pathsPerLaunch, 1, 1 << 20);
   for (const char* grid : {"resolution", "interpolation"})
     if (view) ctx.warnIfChanged(mc.keyOf(grid), "applies to layout \"grid\"; \"view\" ignores it");
-  for (const char* own : {"tile", "slices", "filter", "filterTolerance", "filterTwicing"})
+  for (const char* own : {"tile", "slices", "filter", "filterTwicing"})
     if (!view) ctx.warnIfChanged(mc.keyOf(own), "applies to layout \"view\"; \"grid\" ignores it");
   mc.reportUnknown();
   return s;

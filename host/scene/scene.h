@@ -129,10 +129,8 @@ struct MsCacheSettings {
   // The lights' unscattered light: added by the march (false) or held by the cache with the rest
   // (kernels/shared/ms_cache.h, "Direct"; closure "camera" or layout "view" only).
   bool direct = true;  // the default where it applies (layout view or closure camera), else false
-  // view: the node filter (kernels/shared/ms_cache_filter.h): σ_s in columns (0: off) and k, the
-  // standard errors by which a neighbour may differ before it loses weight.
+  // view: the node filter (kernels/shared/ms_cache_filter.h): σ_s in columns (0: off).
   float filter = 1.5f;
-  float filterTolerance = 2;
   // The filter's residual filtered and added back (ms_cache_filter.h, "Twicing"); default: filter > 0.
   bool filterTwicing = true;
   // Paths per node; default: the quality's.

@@ -11,7 +11,7 @@
  * τ range (ms_view_lookup with column j alone: registered by optical depth as the lookup is, and the
  * column's own reads give its J̄_s exactly); v_s, v_j,s the variances of those means (mean grey L²,
  * MS_CACHE_SQUARE, less J², over the paths n; for j, of its slice holding the range's midpoint). A
- * neighbour within the noise (d² = 0) weighs as much as the column itself; k (msCache.filterTolerance)
+ * neighbour within the noise (d² = 0) weighs as much as the column itself; k (MS_VIEW_FILTER_TOLERANCE)
  * sets how many standard errors beyond it keep e^{−1} of the weight. The filtered column:
  *   J̃_s = Σ_j w_j·J_j,s / Σ_j w_j,   w_j = e^{−(Δx² + Δy²)/(2σ_s²)} · e^{−d²_j},
  * over the columns j with medium within max(1, ⌊2σ_s⌋) on each axis, one weight per column for all its
@@ -39,6 +39,8 @@
 
 #define MS_VIEW_FILTER_EPSILON 1e-20f /* ε: keeps d² finite between noiseless nodes */
 #define MS_VIEW_FILTER_MAX_SLICES 64  /* msCache.slices' upper bound (the loader's) */
+/* k: no other value won on any of eight scenes, 1 and 4 lost on four and two (bench/RESULTS.md). */
+#define MS_VIEW_FILTER_TOLERANCE 2.0f
 
 /* The grey value of a node and the variance of that mean ("v_s"). */
 static inline float ms_view_grey(NV_GLOBAL const float* v) { return (v[0] + v[1] + v[2]) * (1.0f / 3.0f); }

@@ -193,11 +193,11 @@ typedef struct ms_cache_params {
   int direct;             /* 1: the cache holds the lights' unscattered light too (ms_cache.h, "Direct") */
   int filter_twicing;     /* the view layout, filter on: 1: the residual filtered and added back ("Twicing") */
   float filter;           /* the view layout: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
-  float filter_tolerance; /* the filter's k: standard errors a neighbour may differ by */
   int pad0;
   int pad1;
   int pad2;
   int pad3;
+  int pad4;
 } ms_cache_params;
 
 typedef struct scene_params {

@@ -245,7 +245,7 @@ TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
   EXPECT_EQ(s["ms_cache_paths"], 4);
   EXPECT_EQ(s["nan_pixels"], 0);
   EXPECT_NE(r.out.find("multiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
-                       "1.5 columns, tolerance 2 standard errors, twiced) in "),
+                       "1.5 columns, twiced) in "),
             std::string::npos)
       << r.out;
 }
@@ -255,19 +255,17 @@ TEST_F(LightCacheCli, TheViewLayoutIsReportedAsColumnsRowsAndSlices) {
 TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   const std::string cache =
       "--set renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.paths=4 "
-      "--set renderer.raymarch.msCache.tile=4 --set renderer.raymarch.msCache.filter=1 "
-      "--set renderer.raymarch.msCache.filterTolerance=3 ";
+      "--set renderer.raymarch.msCache.tile=4 --set renderer.raymarch.msCache.filter=1 ";
   RunResult r = run("render s.json -o v.exr --stats-json v.json " + cache +
                     "--set renderer.raymarch.msCache.layout=\\\"view\\\"");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   nlohmann::json s = stats("v.json");
   EXPECT_EQ(s["ms_cache_filter"], 1.0);
-  EXPECT_EQ(s["ms_cache_filter_tolerance"], 3.0);
   EXPECT_EQ(s["ms_cache_filter_twicing"], true);  // by default wherever the filter is on
   EXPECT_EQ(s["nan_pixels"], 0);
   EXPECT_NE(r.out.find("multiple-scattering cache: 6x5x8 columns x rows x slices, 4 paths per node, filtered (sigma "
-                       "1 columns, tolerance 3 standard errors, twiced) in "),
+                       "1 columns, twiced) in "),
             std::string::npos)
       << r.out;
   r = run("render s.json -o t.exr --stats-json t.json " + cache +
@@ -276,19 +274,16 @@ TEST_F(LightCacheCli, TheViewFilterIsReportedAndTheGridLayoutIgnoresIt) {
   EXPECT_EQ(r.err, "");
   EXPECT_EQ(stats("t.json")["ms_cache_filter_twicing"], false);
   EXPECT_EQ(stats("t.json")["nan_pixels"], 0);
-  EXPECT_NE(r.out.find(", filtered (sigma 1 columns, tolerance 3 standard errors) in "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(", filtered (sigma 1 columns) in "), std::string::npos) << r.out;
   r = run("render s.json -o g.exr --stats-json g.json " + cache + "--set renderer.raymarch.msCache.layout=\\\"grid\\\"");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err,
             "narval: warning: s.json: renderer.raymarch.msCache.tile: applies to layout \"view\"; \"grid\" "
             "ignores it\n"
             "narval: warning: s.json: renderer.raymarch.msCache.filter: applies to layout \"view\"; \"grid\" "
-            "ignores it\n"
-            "narval: warning: s.json: renderer.raymarch.msCache.filterTolerance: applies to layout \"view\"; "
-            "\"grid\" ignores it\n");
+            "ignores it\n");
   s = stats("g.json");
   EXPECT_EQ(s["ms_cache_filter"], 0.0);
-  EXPECT_EQ(s["ms_cache_filter_tolerance"], 0.0);
 }
 
 // Moving the point light is a new cache: the image changes where its light reaches the cloud.
@@ -368,8 +363,6 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.msCache.filter: must be non-negative, got -1\n"},
       {"renderer.raymarch.msCache.filter=9",
        "narval: s.json: renderer.raymarch.msCache.filter: must be at most 8 (columns), got 9\n"},
-      {"renderer.raymarch.msCache.filterTolerance=0",
-       "narval: s.json: renderer.raymarch.msCache.filterTolerance: must be positive, got 0\n"},
       {"renderer.raymarch.msCache.filterTwicing=true --set renderer.raymarch.msCache.filter=0",
        "narval: s.json: renderer.raymarch.msCache.filterTwicing: needs filter > 0 (it filters the filter's "
        "residual)\n"},

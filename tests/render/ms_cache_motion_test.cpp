@@ -88,7 +88,6 @@ TEST(MsCacheMotion, AnOrbitDrawsTheReprojectionThenEndsAsTheCacheBuiltThere) {
   before.renderer.raymarch.msCache.layout = MsCacheLayout::View;
   before.renderer.raymarch.msCache.tile = 1;
   before.renderer.raymarch.msCache.filter = 1.5f;
-  before.renderer.raymarch.msCache.filterTolerance = 2.0f;
   const Scene after = orbited(before, 30);
   DeviceSceneBuffers devBefore(runtime(), before, nullptr), devAfter(runtime(), after, nullptr);
   const ms_cache_params params = realtimeParams(before, devBefore.scene).msCache;

@@ -172,7 +172,7 @@ TEST(MsCache, RefinementInAnyLaunchSizeGivesTheSameBits) {
 // Every pixel finite, the status clean, the cache partly built.
 TEST(MsCache, APartlyBuiltCacheDrawsFinitePixels) {
   const std::string view = R"("layout": "view", "tile": 1, "slices": 8, "direct": true, "filter": 1.5,
-                              "filterTolerance": 2, "filterTwicing": true)";
+                              "filterTwicing": true)";
   for (const double density : {0.01, 1.0})
     for (const int frames : {2, 4}) {  // the first places the columns, each next adds a slice of nodes
       SCOPED_TRACE("density " + std::to_string(density) + ", " + std::to_string(frames) + " frames");
@@ -227,7 +227,6 @@ TEST(MsCache, BudgetedRefinementInAnySlicesGivesTheSameBits) {
   view.renderer.raymarch.msCache.layout = MsCacheLayout::View;
   view.renderer.raymarch.msCache.tile = 1;
   view.renderer.raymarch.msCache.filter = 1.5f;
-  view.renderer.raymarch.msCache.filterTolerance = 2.0f;
   view.renderer.raymarch.msCache.filterTwicing = true;
   for (const Scene* scene : {&grid, &view}) {
     SCOPED_TRACE(scene == &grid ? "grid layout" : "view layout, filtered and twiced");
@@ -286,7 +285,6 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   scene.renderer.raymarch.msCache.filter = 0;
   const std::vector<float> plain = cacheAfter(scene, 48, 16);
   scene.renderer.raymarch.msCache.filter = 1.5f;
-  scene.renderer.raymarch.msCache.filterTolerance = 2.0f;
   scene.renderer.raymarch.msCache.filterTwicing = false;  // one pass first (the default twices: below)
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
   const ms_cache_params params = realtimeParams(scene, dev.scene).msCache;
@@ -299,7 +297,7 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   EXPECT_EQ(means, plain);
   const node_grid_params& c = params.grid;
   for (int column = 0; column < c.nx * c.ny; ++column)
-    ms_view_filter_column(&c, means.data(), means.data(), 0, column, 1.5f, 2.0f,
+    ms_view_filter_column(&c, means.data(), means.data(), 0, column, 1.5f, MS_VIEW_FILTER_TOLERANCE,
                           host.data() + size_t(column) * MS_CACHE_STRIDE);
   int changed = 0, withMedium = 0;
   for (size_t i = 0; i < host.size(); ++i) {
@@ -327,7 +325,7 @@ TEST(MsCache, TheDevicesFilterIsTheSharedCodeOverTheUnchangedMeans) {
   runtime().queue.enqueueReadBuffer(twicedCache.buffer(), CL_TRUE, 0, twicedDevice.size() * sizeof(float),
                                     twicedDevice.data());
   for (int column = 0; column < c.nx * c.ny; ++column)
-    ms_view_filter_column(&c, means.data(), host.data(), 1, column, 1.5f, 2.0f,
+    ms_view_filter_column(&c, means.data(), host.data(), 1, column, 1.5f, MS_VIEW_FILTER_TOLERANCE,
                           twicedHost.data() + size_t(column) * MS_CACHE_STRIDE);
   int twicedChanged = 0;
   for (size_t i = 0; i < twicedHost.size(); ++i) {
