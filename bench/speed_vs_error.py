@@ -45,7 +45,7 @@ FULL_SWEEPS = {
                        "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2],
                        "areaLightPhase": ["points", "exact"], "msCache.closure": ["linear", "hg"]},
     "raymarch-cache-camera": {"msCache.resolution": [16, 32], "msCache.paths": [256, 1024],
-                              "areaLightPhase": ["points", "exact"], "msCache.interpolation": ["geometric", "linear"]},
+                              "areaLightPhase": ["points", "exact"]},
     "raymarch-cache-view": {"msCache.tile": [2, 4, 8], "msCache.slices": [4, 8, 16],
                             "msCache.paths": [64, 256, 1024], "shadowWeighting": ["area", "phase"]},
     "raymarch-cache-direct": {"msCache.tile": [2, 4], "msCache.slices": [4, 8], "msCache.paths": [128, 256, 512]},

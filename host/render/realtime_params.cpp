@@ -84,10 +84,6 @@ ms_cache_params msCacheParams(const MsCacheSettings& mc, int tile, bool on, cons
     case MsCacheClosure::Camera: p.closure = MS_CACHE_CLOSURE_CAMERA; break;
   }
   if (mc.layout == MsCacheLayout::View) p.closure = MS_CACHE_CLOSURE_CAMERA;
-  switch (mc.interpolation) {
-    case MsCacheInterpolation::Geometric: p.interpolation = MS_CACHE_INTERPOLATION_GEOMETRIC; break;
-    case MsCacheInterpolation::Linear: p.interpolation = MS_CACHE_INTERPOLATION_LINEAR; break;
-  }
   // Only a node aimed at the camera can hold the direct light (the loader refuses it elsewhere; a scene
   // built in code keeps MsCacheSettings' default there).
   p.direct = on && mc.direct && p.closure == MS_CACHE_CLOSURE_CAMERA;

@@ -23,8 +23,6 @@ const EnumNames<AreaLightPhase> kAreaLightPhases = {{"points", AreaLightPhase::P
                                                      {"exact", AreaLightPhase::Exact}};
 const EnumNames<MsCacheClosure> kMsCacheClosures = {
     {"linear", MsCacheClosure::Linear}, {"hg", MsCacheClosure::Hg}, {"camera", MsCacheClosure::Camera}};
-const EnumNames<MsCacheInterpolation> kMsCacheInterpolations = {{"geometric", MsCacheInterpolation::Geometric},
-                                                                {"linear", MsCacheInterpolation::Linear}};
 const EnumNames<ShadowWeighting> kShadowWeightings = {{"area", ShadowWeighting::Area},
                                                       {"phase", ShadowWeighting::Phase}};
 const EnumNames<MsCacheLayout> kMsCacheLayouts = {{"grid", MsCacheLayout::Grid}, {"view", MsCacheLayout::View}};
@@ -136,7 +134,6 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   s.closure = readEnum(mc, "closure", kMsCacheClosures, view ? MsCacheClosure::Camera : s.closure);
   if (view && s.closure != MsCacheClosure::Camera)
     ctx.fail(mc.keyOf("closure"), "must be \"camera\" with layout \"view\" (its paths aim at the camera)");
-  s.interpolation = readEnum(mc, "interpolation", kMsCacheInterpolations, s.interpolation);
   s.resolution = readInt(mc, "resolution", s.resolution, 1, 256);
   s.tile = readAutoInt(mc, "tile", s.tile, kMsCacheTileAuto, 1, 256, "pixels per column side", "");
   // The direct light in the cache where a node can hold it (the camera's direction), else the march's.
@@ -153,8 +150,7 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
     ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
   s.paths = readInt(mc, "paths", s.paths, 1, 1 << 20);
   s.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.pathsPerLaunch, 1, 1 << 20);
-  for (const char* grid : {"resolution", "interpolation"})
-    if (view) ctx.warnIfChanged(mc.keyOf(grid), "applies to layout \"grid\"; \"view\" ignores it");
+  if (view) ctx.warnIfChanged(mc.keyOf("resolution"), "applies to layout \"grid\"; \"view\" ignores it");
   for (const char* own : {"tile", "slices", "filter", "filterTwicing"})
     if (!view) ctx.warnIfChanged(mc.keyOf(own), "applies to layout \"view\"; \"grid\" ignores it");
   mc.reportUnknown();

@@ -103,8 +103,6 @@ enum class ShadowWeighting { Area, Phase };
 // What the cache's two moments (directional average R, first moment b) say about the in-scattering in a
 // direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear expansion, or the HG lobe.
 enum class MsCacheClosure { Linear, Hg, Camera };
-// How the cache mixes its nodes (kernels/shared/ms_cache.h, "Interpolation").
-enum class MsCacheInterpolation { Geometric, Linear };
 // Its nodes: a grid over the medium's box, or image columns with nodes along their optical depth from the
 // camera (kernels/shared/ms_cache_view.h).
 enum class MsCacheLayout { Grid, View };
@@ -121,7 +119,6 @@ RaymarchQualityDefaults raymarchQualityDefaults(RaymarchQuality q);
 constexpr int kMsCacheTileAuto = 0;
 struct MsCacheSettings {
   MsCacheClosure closure = MsCacheClosure::Linear;
-  MsCacheInterpolation interpolation = MsCacheInterpolation::Geometric;
   MsCacheLayout layout = MsCacheLayout::View;
   int resolution = 16;      // grid: cells on the medium box's longest axis
   int tile = kMsCacheTileAuto;  // view: pixels per column side (auto: realtime_params.h, msCacheTile)

@@ -39,17 +39,15 @@
  * isotropic phase function, and depends on the camera: the host starts the cache over when it moves
  * (host/render/device_ms_cache.cpp).
  *
- * Interpolation (ms_cache_params.interpolation): MS_CACHE_INTERPOLATION_GEOMETRIC mixes R as
- * exp(Σ w_k ln R_k), w_k the trilinear weights, and b/R linearly. In a dense medium radiance falls off
- * exponentially with depth (a mean free path can be a fraction of a cell), and a linear mix of a lit node
- * and one many mean free paths deeper paints the deeper one bright, in cell-shaped blocks
+ * Interpolation: R is mixed as exp(Σ w_k ln R_k), w_k the trilinear weights, and b/R linearly. In a
+ * dense medium radiance falls off exponentially with depth (a mean free path can be a fraction of a
+ * cell), and a linear mix of a lit node and one many mean free paths deeper paints the deeper one bright, in cell-shaped blocks
  * (bench/RESULTS.md); the geometric mean is exact for an exponential along each axis, keeps equal
  * corners' value (the white furnace stays 1) and errs, like trilinear, at second order in the node
  * spacing. A node at 0 would pull the whole cell to 0, so R + floor is mixed,
- * floor = MS_CACHE_LOG_FLOOR × the cell's largest R, and taken off after. MS_CACHE_INTERPOLATION_LINEAR
- * mixes R and b (b/R = Σ w_k b_k / Σ w_k R_k): exact for a field linear along each axis, which the
- * geometric mean undershoots (the AM–GM inequality). Which is nearer depends
- * on the medium (bench/RESULTS.md).
+ * floor = MS_CACHE_LOG_FLOOR × the cell's largest R, and taken off after. A linear mix of R and b, exact
+ * for a field linear along each axis (which the geometric mean undershoots: the AM–GM inequality), won on
+ * one scene of eight and lost on four, and was removed (bench/RESULTS.md).
  *
  * Direct (ms_cache_params.direct; closure camera or the view layout only): a node holds the whole
  * in-scattering towards the camera, unscattered light included, so the march has no light loop (no shadow
@@ -133,24 +131,10 @@ static inline float ms_cache_mix_geometric(NV_GLOBAL const float* cache, NV_PRIV
   return nv_fmax(nv_exp(log_r) - floor, 0.0f);
 }
 
-/* The same with R and b mixed linearly, b/R = Σ w_k b_k / Σ w_k R_k ("Interpolation"). */
-static inline float ms_cache_mix_linear(NV_GLOBAL const float* cache, NV_PRIVATE const size_t* at,
-                                        NV_PRIVATE const float* w, int ch, int want_ratio, NV_PRIVATE vec3* ratio) {
-  float R = 0.0f;
-  for (int k = 0; k < 8; ++k) {
-    NV_GLOBAL const float* node = cache + at[k];
-    R += w[k] * node[ch];
-    if (want_ratio) *ratio = vec3_add(*ratio, vec3_scale(ms_cache_node_moment(node, ch), w[k]));
-  }
-  R = nv_fmax(R, 0.0f);
-  *ratio = R > 0.0f ? vec3_scale(*ratio, 1.0f / R) : vec3_splat(0.0f);
-  return R;
-}
-
 /* The rest's in-scattered radiance per unit σs at index-space point p (in [0, dims]) towards w_out
  * (propagation after scattering): R mixed over the cell's eight nodes, times the closure's factor. */
 static inline vec3 ms_cache_lookup(NV_PRIVATE const node_grid_params* c, NV_GLOBAL const float* cache, vec3 dims,
-                                   vec3 p, float g, int closure, int interpolation, vec3 w_out) {
+                                   vec3 p, float g, int closure, vec3 w_out) {
   float w[8];
   size_t at[8];
   node_grid_corners(c, node_grid_locate(c, dims, p), MS_CACHE_STRIDE, at, w);
@@ -158,12 +142,7 @@ static inline vec3 ms_cache_lookup(NV_PRIVATE const node_grid_params* c, NV_GLOB
   const int want_ratio = g != 0.0f && closure != MS_CACHE_CLOSURE_CAMERA; /* b/R read only for a closure */
   for (int ch = 0; ch < 3; ++ch) {
     vec3 ratio = vec3_splat(0.0f);
-    float R;
-    switch (interpolation) {
-      case MS_CACHE_INTERPOLATION_GEOMETRIC: R = ms_cache_mix_geometric(cache, at, w, ch, want_ratio, &ratio); break;
-      case MS_CACHE_INTERPOLATION_LINEAR: R = ms_cache_mix_linear(cache, at, w, ch, want_ratio, &ratio); break;
-      default: R = 0.0f; break; /* unknown: reported at the kernel's entry */
-    }
+    const float R = ms_cache_mix_geometric(cache, at, w, ch, want_ratio, &ratio);
     out[ch] = g != 0.0f ? ms_cache_closure(closure, R, g, ratio, w_out) : R;
   }
   return vec3_make(out[0], out[1], out[2]);

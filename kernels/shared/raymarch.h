@@ -76,7 +76,7 @@ static inline vec3 raymarch_ms_cache(NV_PRIVATE const ms_cache_params* mc, NV_CO
   switch (mc->layout) {
     case MS_CACHE_LAYOUT_GRID:
       return ms_cache_lookup(&mc->grid, ms_cache, vec3_from4(m->dims), p, phase_mean_cosine(m->phase), mc->closure,
-                             mc->interpolation, vec3_scale(dir, -1.0f));
+                             vec3_scale(dir, -1.0f));
     case MS_CACHE_LAYOUT_VIEW: return ms_view_lookup(&mc->grid, ms_cache, cols, tau, dtau);
     default: return vec3_splat(0.0f); /* unknown: reported at the kernel's entry */
   }

@@ -62,11 +62,6 @@ static inline uint ms_cache_kinds_status(NV_PRIVATE const ms_cache_params* mc) {
     case MS_CACHE_CLOSURE_CAMERA: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }
-  switch (mc->interpolation) {
-    case MS_CACHE_INTERPOLATION_GEOMETRIC:
-    case MS_CACHE_INTERPOLATION_LINEAR: break;
-    default: status |= STATUS_UNKNOWN_KIND;
-  }
   switch (mc->layout) {
     case MS_CACHE_LAYOUT_GRID:
     case MS_CACHE_LAYOUT_VIEW: break;

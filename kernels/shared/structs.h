@@ -137,10 +137,6 @@ typedef struct node_grid_params {
 #define MS_CACHE_CLOSURE_HG 1
 #define MS_CACHE_CLOSURE_CAMERA 2
 
-/* How the multiple-scattering cache mixes its nodes (ms_cache.h, "Interpolation"). */
-#define MS_CACHE_INTERPOLATION_GEOMETRIC 0
-#define MS_CACHE_INTERPOLATION_LINEAR 1
-
 /* How a rectangle's shadow weights its K×K points (march_light_column): by each point's share of the
  * light reaching x (cos θ/d²), or (PHASE) of the light x scatters towards the camera (p(θ)·cos θ/d²). */
 #define SHADOW_WEIGHTING_AREA 0
@@ -187,7 +183,7 @@ typedef struct lobe_params {
 typedef struct ms_cache_params {
   node_grid_params grid;  /* the nodes (the view layout: columns nx × ny of slices nz); nx = 0: off */
   int closure;            /* MS_CACHE_CLOSURE_LINEAR, _HG or _CAMERA (ms_cache.h, "Closure") */
-  int interpolation;      /* MS_CACHE_INTERPOLATION_GEOMETRIC or _LINEAR ("Interpolation") */
+  int pad5;
   int layout;             /* MS_CACHE_LAYOUT_GRID or _VIEW (ms_cache_view.h) */
   int tile;               /* the view layout: pixels per column side */
   int direct;             /* 1: the cache holds the lights' unscattered light too (ms_cache.h, "Direct") */

@@ -341,8 +341,6 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.multipleScattering: unknown value \"fog\" (allowed: none, octaves, cache)\n"},
       {"renderer.raymarch.msCache.closure=\\\"vmf\\\"",
        "narval: s.json: renderer.raymarch.msCache.closure: unknown value \"vmf\" (allowed: linear, hg, camera)\n"},
-      {"renderer.raymarch.msCache.interpolation=\\\"cubic\\\"",
-       "narval: s.json: renderer.raymarch.msCache.interpolation: unknown value \"cubic\" (allowed: geometric, linear)\n"},
       {"renderer.raymarch.msCache.resolution=0",
        "narval: s.json: renderer.raymarch.msCache.resolution: must be at least 1, got 0\n"},
       {"renderer.raymarch.msCache.layout=\\\"froxels\\\"",

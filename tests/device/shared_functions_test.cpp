@@ -583,9 +583,6 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
   lp.variant = LOBE_CORRECTED;
   EXPECT_EQ(probe()[0], 0u);
-  mc.interpolation = 2;
-  EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
-  mc.interpolation = MS_CACHE_INTERPOLATION_LINEAR;
   mc.layout = MS_CACHE_LAYOUT_VIEW;
   EXPECT_EQ(probe()[0], 0u);
   mc.layout = 2;
