@@ -41,10 +41,10 @@
  *
  * Interpolation: R is mixed as exp(Σ w_k ln R_k), w_k the trilinear weights, and b/R linearly. In a
  * dense medium radiance falls off exponentially with depth (a mean free path can be a fraction of a
- * cell), and a linear mix of a lit node and one many mean free paths deeper paints the deeper one bright, in cell-shaped blocks
- * (bench/RESULTS.md); the geometric mean is exact for an exponential along each axis, keeps equal
- * corners' value (the white furnace stays 1) and errs, like trilinear, at second order in the node
- * spacing. A node at 0 would pull the whole cell to 0, so R + floor is mixed,
+ * cell), and a linear mix of a lit node and one many mean free paths deeper paints the deeper one
+ * bright, in cell-shaped blocks (bench/RESULTS.md); the geometric mean is exact for an exponential
+ * along each axis, keeps equal corners' value (the white furnace stays 1) and errs, like trilinear, at
+ * second order in the node spacing. A node at 0 would pull the whole cell to 0, so R + floor is mixed,
  * floor = MS_CACHE_LOG_FLOOR × the cell's largest R, and taken off after. A linear mix of R and b, exact
  * for a field linear along each axis (which the geometric mean undershoots: the AM–GM inequality), won on
  * one scene of eight and lost on four, and was removed (bench/RESULTS.md).

@@ -105,8 +105,8 @@ static inline void ms_view_blend_node(NV_GLOBAL const float* prior, NV_GLOBAL co
                                       NV_GLOBAL float* out) {
   for (int i = 0; i < MS_CACHE_STRIDE; ++i) out[i] = fresh[i];
   if (!(fresh[MS_VIEW_TAU] >= 0.0f)) return;
-  const float n = fresh[3], N = (float)target;
-  const float m = prior[3] * nv_fmax(0.0f, 1.0f - n / nv_fmax(N, 1.0f));
+  const float n = fresh[3];
+  const float m = prior[3] * nv_fmax(0.0f, 1.0f - n / nv_fmax((float)target, 1.0f));
   if (!(n > 0.0f)) { /* no new path yet: the prior alone */
     for (int i = 0; i < 4; ++i) out[i] = prior[i];
     return;

@@ -183,7 +183,6 @@ typedef struct lobe_params {
 typedef struct ms_cache_params {
   node_grid_params grid;  /* the nodes (the view layout: columns nx × ny of slices nz); nx = 0: off */
   int closure;            /* MS_CACHE_CLOSURE_LINEAR, _HG or _CAMERA (ms_cache.h, "Closure") */
-  int pad5;
   int layout;             /* MS_CACHE_LAYOUT_GRID or _VIEW (ms_cache_view.h) */
   int tile;               /* the view layout: pixels per column side */
   int direct;             /* 1: the cache holds the lights' unscattered light too (ms_cache.h, "Direct") */
@@ -191,9 +190,6 @@ typedef struct ms_cache_params {
   float filter;           /* the view layout: the filter's σ_s in columns; 0: off (ms_cache_filter.h) */
   int pad0;
   int pad1;
-  int pad2;
-  int pad3;
-  int pad4;
 } ms_cache_params;
 
 typedef struct scene_params {

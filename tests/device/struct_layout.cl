@@ -48,10 +48,9 @@
   F(lobe_params, view_steps) F(lobe_params, variant) F(lobe_params, pad0) F(lobe_params, pad1)            \
   F(lobe_params, pad2)                                                                                    \
   S(ms_cache_params) F(ms_cache_params, grid) F(ms_cache_params, grid.nz) F(ms_cache_params, closure)     \
-  F(ms_cache_params, pad5) F(ms_cache_params, layout) F(ms_cache_params, tile)                   \
-  F(ms_cache_params, direct) F(ms_cache_params, filter_twicing) F(ms_cache_params, filter)                \
-  F(ms_cache_params, pad0) F(ms_cache_params, pad1) F(ms_cache_params, pad2) F(ms_cache_params, pad3)    \
-  F(ms_cache_params, pad4)                                                                                \
+  F(ms_cache_params, layout) F(ms_cache_params, tile) F(ms_cache_params, direct)                          \
+  F(ms_cache_params, filter_twicing) F(ms_cache_params, filter) F(ms_cache_params, pad0)                  \
+  F(ms_cache_params, pad1)                                                                                \
   S(node_grid_params) F(node_grid_params, index_to_world) F(node_grid_params, nx)           \
   F(node_grid_params, ny) F(node_grid_params, nz) F(node_grid_params, pad0)
 
