@@ -6,9 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <string_view>
 #include <vector>
 
+#include "image/image.h"
 #include "render/device_ms_cache.h"
 #include "render/device_scene.h"
 #include "render/node_grid_layout.h"
@@ -503,7 +507,7 @@ ImageRGB averaged(const ImageRGB& a, const ImageRGB& b) {
 // var_cache(2N) is about half of var_cache(N); the bound's noise term is then at most
 // sqrt(1.5/1.125) = 1.15 times what 2048 fine paths give, at a quarter of their cost. Cases of the
 // same box, phase function and light share one path-traced reference and one other renderer: each
-// is rendered once.
+// is rendered once. The references are stored (litBoxReference).
 struct LitBoxCase {
   const char* what;          // printed with the case's figures
   std::string coarse, fine;  // msCache keys
@@ -518,15 +522,46 @@ struct LitBoxCheck {
 // Checks every case against the shared reference, printing what each measured and asserting its
 // widest bound and that the other renderer is outside the bound on at least otherShare of the tile
 // channels (a bound that can tell).
-std::vector<LitBoxCheck> checkLitBox(const std::string& phase, const std::vector<LitBoxCase>& cases,
-                                     const std::string& otherMs, const std::string& otherCache, const char* otherName,
-                                     double otherShare, const std::string& light = kLitBoxBulb, SceneGrids grid = {}) {
+// The path tracer's image of a lit box (the scene `json` with `seed`, on `grid`), stored in
+// tests/data/reference/NAME_seedSEED.exr: the two 16384-spp renders a lit-box test compares with cost more
+// than the rest of it, and they are the path tracer's answer, which its own tests (analytic scenes,
+// Mitsuba 3 in bench/) check. NARVAL_WRITE_REFERENCE=1 renders and writes them (on PoCL, then committed).
+// Each file holds the scene it was rendered from (and a digest of the grid's voxels): a test whose scene
+// changed fails here, naming the file, instead of comparing with another scene's picture.
+ImageRGB litBoxReference(const std::string& name, const std::string& json, uint32_t seed, SceneGrids grid) {
+  const std::string path =
+      std::string(NARVAL_SOURCE_DIR) + "/tests/data/reference/" + name + "_seed" + std::to_string(seed) + ".exr";
+  std::string key = json + " seed " + std::to_string(seed);
+  if (grid.density) {
+    const std::string_view voxels(reinterpret_cast<const char*>(grid.density->data.data()),
+                                  grid.density->data.size() * sizeof(float));
+    key += " grid " + std::to_string(grid.density->nx) + "x" + std::to_string(grid.density->ny) + "x" +
+           std::to_string(grid.density->nz) + " " + std::to_string(std::hash<std::string_view>{}(voxels));
+  }
+  if (std::getenv("NARVAL_WRITE_REFERENCE")) {
+    Scene scene = sceneFromJson(json);
+    scene.renderer.seed = seed;
+    const RenderResult r = render(scene, grid);
+    EXPECT_EQ(r.stats.status, 0u);
+    writeExr(path, r.image, {{"narval:litBox", key}});
+  }
+  const auto attributes = readExrAttributes(path);
+  const auto stored = attributes.find("narval:litBox");
+  EXPECT_TRUE(stored != attributes.end() && stored->second == key)
+      << path << " was rendered from another scene: render it again with NARVAL_WRITE_REFERENCE=1";
+  return readExr(path);
+}
+
+std::vector<LitBoxCheck> checkLitBox(const std::string& reference, const std::string& phase,
+                                     const std::vector<LitBoxCase>& cases, const std::string& otherMs,
+                                     const std::string& otherCache, const char* otherName, double otherShare,
+                                     const std::string& light = kLitBoxBulb, SceneGrids grid = {}) {
   auto scene = [&](const std::string& renderer, uint32_t seed) {
     Scene s = sceneFromJson(litBoxJson(renderer, phase, light));
     s.renderer.seed = seed;
     return s;
   };
-  const std::string pt = R"({"resolution": [16, 16], "spp": 16384, "bounces": 64})";
+  const std::string pt = litBoxJson(R"({"resolution": [16, 16], "spp": 16384, "bounces": 64})", phase, light);
   // The cases name what they differ in from the settings these bounds were derived for: the grid
   // layout, and neither the direct light nor the view layout's filter (the loader's defaults hold both).
   auto rm = [](int steps, const std::string& ms, const std::string& cache, int paths) {
@@ -544,10 +579,9 @@ std::vector<LitBoxCheck> checkLitBox(const std::string& phase, const std::vector
     EXPECT_EQ(r.stats.status, 0u);
     return r.image;
   };
-  const RenderResult ptA = render(scene(pt, 1), grid), ptB = render(scene(pt, 2), grid);
-  EXPECT_EQ(ptA.stats.status, 0u);
-  const std::vector<double> ref = tileMeans(averaged(ptA.image, ptB.image));
-  const std::vector<double> varPt = tileVarianceOfMean(ptA.image, ptB.image);
+  const ImageRGB ptA = litBoxReference(reference, pt, 1, grid), ptB = litBoxReference(reference, pt, 2, grid);
+  const std::vector<double> ref = tileMeans(averaged(ptA, ptB));
+  const std::vector<double> varPt = tileVarianceOfMean(ptA, ptB);
   const std::vector<double> otherMeans = tileMeans(realtime(rm(64, otherMs, otherCache, 2048), 1));
   std::vector<LitBoxCheck> checks;
   for (const LitBoxCase& c : cases) {
@@ -599,7 +633,7 @@ std::vector<LitBoxCheck> checkLitBox(const std::string& phase, const std::vector
 // alone (no cache) is outside it nearly everywhere. Cells 8 → 16, steps 64 → 128; 2048 and 512 paths
 // per node, 2 × 16384 spp for the path tracer.
 TEST(MsCache, IsotropicLitBoxMatchesThePathTracer) {
-  checkLitBox(R"("phaseFunction": "isotropic")", {{"isotropic", R"("resolution": 8)", R"("resolution": 16)", 0.06}},
+  checkLitBox("lit_box_isotropic", R"("phaseFunction": "isotropic")", {{"isotropic", R"("resolution": 8)", R"("resolution": 16)", 0.06}},
               "none", R"("resolution": 8)", "single scattering alone", 0.9);
 }
 
@@ -629,7 +663,7 @@ TEST(MsCache, IsotropicLitBoxMatchesThePathTracer) {
 //   then comes from the cache, and the same bound applies (the point light is met by the shadow rays
 //   alone; the rectangle, below, by both). Widest bound 16.8% (asserted ≤ 30%).
 TEST(MsCache, CameraAimedCachesMatchThePathTracerForAForwardPhaseFunction) {
-  checkLitBox(R"("phaseFunction": "hg", "g": 0.8)",
+  checkLitBox("lit_box_hg", R"("phaseFunction": "hg", "g": 0.8)",
               {{"HG 0.8, closure camera", R"("resolution": 8, "closure": "camera")",
                 R"("resolution": 16, "closure": "camera")", 0.2},
                {"HG 0.8, layout view", R"("layout": "view", "tile": 2, "slices": 8)",
@@ -645,7 +679,7 @@ TEST(MsCache, CameraAimedCachesMatchThePathTracerForAForwardPhaseFunction) {
 // closure, whose single scattering the march computes, falls outside the bound on every tile
 // channel (measured 48 of 48). Widest bound 14.0% (asserted ≤ 30%).
 TEST(MsCache, ViewLayoutHoldingARectangleLightMatchesThePathTracer) {
-  checkLitBox(R"("phaseFunction": "hg", "g": 0.8)",
+  checkLitBox("lit_box_hg_rectangle", R"("phaseFunction": "hg", "g": 0.8)",
               {{"HG 0.8, rectangle light, layout view with the direct light",
                 R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
                 R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", 0.3}},
@@ -677,7 +711,7 @@ TEST(MsCache, ViewLayoutHoldingTheDirectLightMatchesThePathTracerInAHeterogeneou
         ramp.data[size_t(x) + 32 * (size_t(y) + 32 * size_t(z))] = d;
         ramp.maxValue = std::max(ramp.maxValue, d);
       }
-  checkLitBox(R"("phaseFunction": "hg", "g": 0.8)",
+  checkLitBox("lit_box_hg_rectangle_ramp", R"("phaseFunction": "hg", "g": 0.8)",
               {{"HG 0.8, rectangle light, heterogeneous, layout view with the direct light",
                 R"("layout": "view", "tile": 2, "slices": 8, "direct": true)",
                 R"("layout": "view", "tile": 1, "slices": 16, "direct": true)", 0.25}},
