@@ -370,7 +370,9 @@ TEST(ProgramCache, CorruptEntriesFallBackToTheSourceAndAreRewritten) {
   // Truncated: the header's size no longer matches.
   std::ofstream(entry, std::ios::binary | std::ios::trunc) << good.substr(0, good.size() / 2);
   EXPECT_FALSE(runProbeHitsCache(rt, "", 2));
-  EXPECT_EQ(readFile(entry), good) << "the entry is rewritten";
+  // Rewritten whole, so read back as a hit (not byte for byte the first entry: a PoCL binary also holds
+  // the kernels compiled into PoCL's own cache since, by this test's run or another process's).
+  EXPECT_TRUE(buildProbeHitsCache(rt)) << "the entry is rewritten";
 
   // A well-formed entry whose payload the driver must refuse.
   const std::string payload = "this is not a program binary";
