@@ -43,7 +43,7 @@ FULL_SWEEPS = {
     "raymarch-octaves": {"octaves": [2, 4, 8], "steps": [30, 60, 120]},
     "raymarch-cache": {"msCache.resolution": [8, 16, 32], "msCache.paths": [64, 256, 1024], "steps": [30, 60, 120],
                        "shadowAreaSamples": [1, 4], "areaLightSamples": [1, 2],
-                       "areaLightPhase": ["points", "exact"], "msCache.closure": ["linear", "hg"]},
+                       "areaLightPhase": ["points", "exact"]},
     "raymarch-cache-camera": {"msCache.resolution": [16, 32], "msCache.paths": [256, 1024],
                               "areaLightPhase": ["points", "exact"]},
     "raymarch-cache-view": {"msCache.tile": [2, 4, 8], "msCache.slices": [4, 8, 16],

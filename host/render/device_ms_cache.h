@@ -24,6 +24,10 @@ struct MsCacheSnapshot {
   camera_params camera{};  // the view layout's: the camera its nodes are placed and aimed for
 };
 
+// The most paths per node one build launch adds, unless a caller asks for fewer (tests): it bounds
+// a launch's time (a GPU's watchdog, an interrupt between launches); the cache is the same for any split.
+constexpr int kMsCachePathsPerLaunch = 32;
+
 class DeviceMsCache {
  public:
   // Brings the cache to at least `targetPaths` paths per node for the scene on `dev` and params.grid (nx > 0),

@@ -54,7 +54,7 @@ nlohmann::json msCacheSettings(const Scene& scene) {
   nlohmann::json ms = raymarch.at("msCache");
   // Keys the nodes' running means do not depend on: the paths to go on to, and how a lookup reads
   // the nodes (the filter's copy is made again from the means).
-  for (const char* k : {"paths", "pathsPerLaunch", "filter", "filterTwicing"})
+  for (const char* k : {"paths", "filter", "filterTwicing"})
     ms.erase(k);
   doc["renderer"].erase("lightCache");  // the march's shadows, which the cache's paths do not read
   doc["renderer"].erase("algorithm");   // the ray marcher's, wherever the viewer starts

@@ -23,9 +23,8 @@ struct MsCacheFile {
 
 // What the cache's paths depend on: renderSettings (render_exr.h: the scene less the display and
 // real-time keys, less the light cache) with renderer.raymarch.multipleScattering and msCache (less
-// paths and pathsPerLaunch, which a read cache may go on refining to, and the filter, which only
-// reads the nodes), less the camera and the image size where the cache does
-// not depend on them.
+// paths, which a read cache may go on refining to, and the filter, which only reads the nodes), less
+// the camera and the image size where the cache does not depend on them.
 nlohmann::json msCacheSettings(const Scene& scene);
 
 // The refusal of `flag` (--ms-cache-in, --ms-cache-out) for a scene that draws no such cache.

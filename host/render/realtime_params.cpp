@@ -80,7 +80,6 @@ ms_cache_params msCacheParams(const MsCacheSettings& mc, int tile, bool on, cons
   }
   switch (mc.closure) {
     case MsCacheClosure::Linear: p.closure = MS_CACHE_CLOSURE_LINEAR; break;
-    case MsCacheClosure::Hg: p.closure = MS_CACHE_CLOSURE_HG; break;
     case MsCacheClosure::Camera: p.closure = MS_CACHE_CLOSURE_CAMERA; break;
   }
   if (mc.layout == MsCacheLayout::View) p.closure = MS_CACHE_CLOSURE_CAMERA;

@@ -111,7 +111,7 @@ double RealtimeRenderer::renderFrame(double cacheBudgetMs, double* wallMs) {
   }
   if (params_.msCache.grid.nx > 0) {  // built to its paths (within a budget: over frames), then kept
     const MsCacheSettings& mc = view_.renderer.raymarch.msCache;
-    msCache_.refine(rt_, dev_, params_.msCache, mc.paths, mc.pathsPerLaunch, view_.sourcePath, cacheBudgetMs);
+    msCache_.refine(rt_, dev_, params_.msCache, mc.paths, kMsCachePathsPerLaunch, view_.sourcePath, cacheBudgetMs);
     kernel_.set("ms_cache_nodes", msCache_.buffer());
   }
   const int W = view_.renderer.width, H = view_.renderer.height;

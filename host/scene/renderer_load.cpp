@@ -22,7 +22,7 @@ const EnumNames<LightSampling> kLightSamplings = {
 const EnumNames<AreaLightPhase> kAreaLightPhases = {{"points", AreaLightPhase::Points},
                                                      {"exact", AreaLightPhase::Exact}};
 const EnumNames<MsCacheClosure> kMsCacheClosures = {
-    {"linear", MsCacheClosure::Linear}, {"hg", MsCacheClosure::Hg}, {"camera", MsCacheClosure::Camera}};
+    {"linear", MsCacheClosure::Linear}, {"camera", MsCacheClosure::Camera}};
 const EnumNames<ShadowWeighting> kShadowWeightings = {{"area", ShadowWeighting::Area},
                                                       {"phase", ShadowWeighting::Phase}};
 const EnumNames<MsCacheLayout> kMsCacheLayouts = {{"grid", MsCacheLayout::Grid}, {"view", MsCacheLayout::View}};
@@ -149,7 +149,6 @@ MsCacheSettings readMsCache(JsonContext& ctx, const json& value, const std::stri
   if (s.filterTwicing && view && !(s.filter > 0))
     ctx.fail(mc.keyOf("filterTwicing"), "needs filter > 0 (it filters the filter's residual)");
   s.paths = readInt(mc, "paths", s.paths, 1, 1 << 20);
-  s.pathsPerLaunch = readInt(mc, "pathsPerLaunch", s.pathsPerLaunch, 1, 1 << 20);
   if (view) ctx.warnIfChanged(mc.keyOf("resolution"), "applies to layout \"grid\"; \"view\" ignores it");
   for (const char* own : {"tile", "slices", "filter", "filterTwicing"})
     if (!view) ctx.warnIfChanged(mc.keyOf(own), "applies to layout \"view\"; \"grid\" ignores it");

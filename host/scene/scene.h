@@ -101,8 +101,9 @@ enum class AreaLightPhase { Points, Exact };
 enum class ShadowWeighting { Area, Phase };
 
 // What the cache's two moments (directional average R, first moment b) say about the in-scattering in a
-// direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear expansion, or the HG lobe.
-enum class MsCacheClosure { Linear, Hg, Camera };
+// direction (kernels/shared/ms_cache.h, "Closure"): the truncated linear expansion, or none: the paths aim
+// at the camera.
+enum class MsCacheClosure { Linear, Camera };
 // Its nodes: a grid over the medium's box, or image columns with nodes along their optical depth from the
 // camera (kernels/shared/ms_cache_view.h).
 enum class MsCacheLayout { Grid, View };
@@ -132,7 +133,6 @@ struct MsCacheSettings {
   bool filterTwicing = true;
   // Paths per node; default: the quality's.
   int paths = 100;
-  int pathsPerLaunch = 32;  // paths per node per build launch (progress and refinement granularity)
 };
 
 struct RaymarchSettings {

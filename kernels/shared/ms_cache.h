@@ -25,13 +25,8 @@
  * truncation can dip below); exact for a field linear in w, but a field concentrated along its mean
  * direction (dense clouds at g 0.8–0.9, light scattered forwards a few times) has |b|/R near its bound 3,
  * so 1 − g·|b|/R ≈ 0 backwards (where front-lit clouds are seen from) and at most 1 + 3g forwards.
- * MS_CACHE_CLOSURE_HG: the field of the same R and b that is an HG lobe about b,
- * L(w) = 4πR·p_HG(μ, w·b̂), μ = |b|/(3R) (then (3/4π)∫L w dw = 3Rμ·b̂ = b); HG lobes convolve exactly
- * (Legendre coefficients multiply, gˡ·μˡ = (gμ)ˡ), so with k = gμ
- *   ∫ p_HG(g, w·w_out) L(w) dw = 4πR·p_HG(gμ, b̂·w_out) = R·(1 − k²)/(1 + k² − 2k·b̂·w_out)^{3/2},
- * positive everywhere, the linear closure to first order in μ, R for an isotropic field; μ is kept below
- * 0.99 (a noisy b can exceed its bound). Neither is right everywhere: the default cloud's broad one-sided
- * dark front wants the linear one, its multi-peaked sunlit rim more than HG gives.
+ (An HG lobe of the same R and b, which convolves with an HG phase function in closed form, was a closure
+ * too: it won on one of eight scenes, lost on two, and went; bench/RESULTS.md.)
  * MS_CACHE_CLOSURE_CAMERA needs none: a node's paths draw their directions from the phase function about
  * w_c, the direction to the camera, so their mean radiance is the in-scattering towards the camera,
  * ∫ p(w·w_c) L(w) dw (importance sampled: p/pdf = 1). It is exact in direction up to w_c being the
@@ -82,13 +77,6 @@
 static inline float ms_cache_closure(int closure, float R, float g, vec3 m, vec3 w_out) {
   switch (closure) {
     case MS_CACHE_CLOSURE_LINEAR: return nv_fmax(0.0f, R * (1.0f + g * vec3_dot(m, w_out)));
-    case MS_CACHE_CLOSURE_HG: {
-      const float len = vec3_length(m);
-      if (!(len > 0.0f)) return R;
-      const float k = g * nv_fmin(0.99f, len / 3.0f);
-      const float d = 1.0f + k * k - 2.0f * k * (vec3_dot(m, w_out) / len);
-      return R * (1.0f - k * k) / (d * nv_sqrt(d));
-    }
     case MS_CACHE_CLOSURE_CAMERA: return R; /* the node's R is the in-scattering towards the camera */
     default: return 0.0f; /* unknown: reported at the kernel's entry */
   }

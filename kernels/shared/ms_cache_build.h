@@ -45,8 +45,7 @@ static inline vec3 ms_cache_to_camera(NV_CONSTANT const scene_params* s, vec3 x)
 static inline vec3 ms_cache_direction(NV_CONSTANT const scene_params* s, int closure, vec3 w_c, float u1, float u2,
                                       NV_PRIVATE float* pdf) {
   switch (closure) {
-    case MS_CACHE_CLOSURE_LINEAR:
-    case MS_CACHE_CLOSURE_HG: *pdf = 0.25f * NV_INV_PI; return sample_uniform_sphere(u1, u2);
+    case MS_CACHE_CLOSURE_LINEAR: *pdf = 0.25f * NV_INV_PI; return sample_uniform_sphere(u1, u2);
     case MS_CACHE_CLOSURE_CAMERA:
       return vec3_scale(phase_sample(s->medium.phase, w_c, u1, u2, pdf), -1.0f);
     default: *pdf = 0.0f; return sample_uniform_sphere(u1, u2); /* unknown: reported at the kernel's entry */

@@ -58,7 +58,6 @@ static inline uint ms_cache_kinds_status(NV_PRIVATE const ms_cache_params* mc) {
   uint status = 0u;
   switch (mc->closure) {
     case MS_CACHE_CLOSURE_LINEAR:
-    case MS_CACHE_CLOSURE_HG:
     case MS_CACHE_CLOSURE_CAMERA: break;
     default: status |= STATUS_UNKNOWN_KIND;
   }

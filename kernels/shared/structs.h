@@ -134,8 +134,7 @@ typedef struct node_grid_params {
 /* How the multiple-scattering cache answers for a direction (ms_cache.h, "Closure"): from its two
  * moments, or (CAMERA) with the in-scattering towards the camera estimated directly. */
 #define MS_CACHE_CLOSURE_LINEAR 0
-#define MS_CACHE_CLOSURE_HG 1
-#define MS_CACHE_CLOSURE_CAMERA 2
+#define MS_CACHE_CLOSURE_CAMERA 2 /* 1 was an HG lobe's closure (removed) */
 
 /* How a rectangle's shadow weights its K×K points (march_light_column): by each point's share of the
  * light reaching x (cos θ/d²), or (PHASE) of the light x scatters towards the camera (p(θ)·cos θ/d²). */

@@ -75,11 +75,11 @@ TEST_F(LightCacheCli, FramesBuildTheCacheOnceAndTheStatsReportIt) {
 TEST_F(LightCacheCli, TheMultipleScatteringCacheIsBuiltOnceAndReported) {
   const RunResult r = run("render s.json -o m.exr --frames 3 --stats-json m.json --set "
                           "renderer.raymarch.multipleScattering=\\\"cache\\\" --set renderer.raymarch.msCache.layout=\\\"grid\\\" "
-                          "--set renderer.raymarch.msCache.resolution=4 --set renderer.raymarch.msCache.paths=6 --set renderer.raymarch.msCache.pathsPerLaunch=4");
+                          "--set renderer.raymarch.msCache.resolution=4 --set renderer.raymarch.msCache.paths=6");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json s = stats("m.json");
   EXPECT_EQ(s["ms_cache_cells"], nlohmann::json::array({4, 4, 4}));
-  EXPECT_EQ(s["ms_cache_paths"], 6);  // 4 + 2 in two launches
+  EXPECT_EQ(s["ms_cache_paths"], 6);
   EXPECT_EQ(s["ms_cache_builds"], 1);
   EXPECT_GT(s["ms_cache_ms"].get<double>(), 0.0);
   EXPECT_NE(r.out.find("\nmultiple-scattering cache: 4x4x4 cells, 6 paths per node in "), std::string::npos) << r.out;
@@ -340,7 +340,7 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
       {"renderer.raymarch.multipleScattering=\\\"fog\\\"",
        "narval: s.json: renderer.raymarch.multipleScattering: unknown value \"fog\" (allowed: none, octaves, cache)\n"},
       {"renderer.raymarch.msCache.closure=\\\"vmf\\\"",
-       "narval: s.json: renderer.raymarch.msCache.closure: unknown value \"vmf\" (allowed: linear, hg, camera)\n"},
+       "narval: s.json: renderer.raymarch.msCache.closure: unknown value \"vmf\" (allowed: linear, camera)\n"},
       {"renderer.raymarch.msCache.resolution=0",
        "narval: s.json: renderer.raymarch.msCache.resolution: must be at least 1, got 0\n"},
       {"renderer.raymarch.msCache.layout=\\\"froxels\\\"",
@@ -368,7 +368,7 @@ TEST_F(LightCacheCli, BadValuesAreOneLineAndExitTwo) {
        "narval: s.json: renderer.raymarch.msCache.filterTwicing: expected a boolean, got number\n"},
       {"renderer.raymarch.msCache.filter=\\\"wide\\\"",
        "narval: s.json: renderer.raymarch.msCache.filter: expected a number, got string\n"},
-      {"renderer.raymarch.msCache.closure=\\\"hg\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",
+      {"renderer.raymarch.msCache.closure=\\\"linear\\\" --set renderer.raymarch.msCache.layout=\\\"view\\\"",
        "narval: s.json: renderer.raymarch.msCache.closure: must be \"camera\" with layout \"view\" (its paths aim at "
        "the camera)\n"},
       {"renderer.raymarch.shadowAreaSamples=0",

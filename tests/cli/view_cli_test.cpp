@@ -31,7 +31,7 @@ class ViewCli : public CliFixture {
     nlohmann::json scene = nlohmann::json::parse(fogSceneJson(64, 48, 12));
     scene["renderer"]["algorithm"] = "raymarch";
     scene["renderer"]["raymarch"] = {{"multipleScattering", "cache"},
-                                     {"msCache", {{"layout", "grid"}, {"resolution", 4}, {"paths", 64}, {"pathsPerLaunch", 16}}}};
+                                     {"msCache", {{"layout", "grid"}, {"resolution", 4}, {"paths", 64}}}};
     write("fog.json", scene.dump(2));
   }
   nlohmann::json stats(const std::string& name) { return nlohmann::json::parse(readFile(dir_ / name)); }

@@ -554,7 +554,7 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
   };
   const vec3 w = vec3_make(0, 0, 1);
   for (int phase : {AREA_LIGHT_POINTS, AREA_LIGHT_EXACT})
-    for (int closure : {MS_CACHE_CLOSURE_LINEAR, MS_CACHE_CLOSURE_HG, MS_CACHE_CLOSURE_CAMERA}) {
+    for (int closure : {MS_CACHE_CLOSURE_LINEAR, MS_CACHE_CLOSURE_CAMERA}) {
       mp.area_light_phase = phase;
       mc.closure = closure;
       const std::vector<cl_uint> out = probe();
@@ -567,18 +567,18 @@ TEST_F(SharedOnDevice, UnknownRealtimeKindsSetTheStatusBitAndSendNothing) {
     }
   // The camera closure: the node's R is already the in-scattering towards the camera.
   EXPECT_EQ(ms_cache_closure(MS_CACHE_CLOSURE_CAMERA, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w), 2.0f);
-  // HG closure, forwards: 4πR·p_HG(k, 1) = R(1 + k)/(1 − k)², k = 0.8·0.3 = 0.24: 2·1.24/0.5776.
-  EXPECT_NEAR(ms_cache_closure(MS_CACHE_CLOSURE_HG, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w), 2 * 1.24 / 0.5776, 1e-5);
+  // The linear closure forwards: R(1 + g·m·w) = 2·(1 + 0.8·0.9).
+  EXPECT_NEAR(ms_cache_closure(MS_CACHE_CLOSURE_LINEAR, 2.0f, 0.8f, vec3_make(0, 0, 0.9f), w), 2 * 1.72, 1e-5);
   mp.area_light_phase = 3;
   std::vector<cl_uint> out = probe();
   EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
   EXPECT_EQ(value(out[1]), 0.0f);
   mp.area_light_phase = AREA_LIGHT_EXACT;
-  mc.closure = 4;
+  mc.closure = 1;  // the removed HG closure's id
   out = probe();
   EXPECT_EQ(out[0], STATUS_UNKNOWN_KIND);
   EXPECT_EQ(value(out[2]), 0.0f);
-  mc.closure = MS_CACHE_CLOSURE_HG;
+  mc.closure = MS_CACHE_CLOSURE_LINEAR;
   lp.variant = 2;
   EXPECT_EQ(probe()[0], STATUS_UNKNOWN_KIND);
   lp.variant = LOBE_CORRECTED;

@@ -187,7 +187,6 @@ TEST(EmissionRender, DeepInsideAnEmittingScatteringMediumLApproachesLe) {
   cached.renderer.raymarch.multipleScattering = MultipleScattering::Cache;
   cached.renderer.raymarch.msCache.resolution = 4;
   cached.renderer.raymarch.msCache.paths = 1024;
-  cached.renderer.raymarch.msCache.pathsPerLaunch = 1024;
   const RenderResult r = renderAlgorithm(cached);
   ASSERT_EQ(r.stats.status, 0u);
   for (int y = 0; y < 16; ++y)

@@ -52,7 +52,7 @@ TEST(MsCacheMotion, TheWhiteFurnaceIsOneInEveryFrameAcrossOrbits) {
     "camera": {"position": [0, 0, -3], "lookAt": [0, 0, 0], "vfov": 30},
     "renderer": {"resolution": [16, 16], "algorithm": "raymarch", "bounces": 1000, "storage": "buffer",
                  "raymarch": {"steps": 40, "minTransmittance": 0, "multipleScattering": "cache",
-                              "msCache": {"layout": "view", "tile": 1, "filter": 1.5, "paths": 4, "pathsPerLaunch": 4}}},
+                              "msCache": {"layout": "view", "tile": 1, "filter": 1.5, "paths": 4}}},
     "background": [1, 1, 1]
   })");
   RealtimeRenderer r(runtime(), scene, nullptr);

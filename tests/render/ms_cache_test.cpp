@@ -41,7 +41,7 @@ std::string furnaceJson(const std::string& multipleScattering, double density = 
     "camera": {"position": [0, 0, -3], "lookAt": [0, 0, 0], "vfov": 30},
     "renderer": {"resolution": [16, 16], "algorithm": "raymarch", "bounces": 1000, "storage": "buffer",
                  "raymarch": {"steps": 40, "minTransmittance": 0, "multipleScattering": ")" + multipleScattering +
-         R"(", "msCache": {)" + layout + R"(, "paths": 8, "pathsPerLaunch": 4}}},
+         R"(", "msCache": {)" + layout + R"(, "paths": 8}}},
     "background": [1, 1, 1]
   })";
 }
@@ -377,14 +377,13 @@ TEST(MsCache, StartsOverOnlyWhenWhatThePathsSeeChanges) {
 }
 
 // With the closure "camera" the paths aim at the camera (ms_cache.h, "Closure"), so a camera move
-// starts the cache over too; the same camera keeps it, and switching to it from a moment closure
-// starts over (the paths' directions differ), while linear and hg share their paths.
+// starts the cache over too; the same camera keeps it, and switching to it from the moments' linear
+// closure starts over (the paths' directions differ).
 TEST(MsCache, TheCameraClosureStartsOverWhenTheCameraMoves) {
   Scene scene = litBox();
   DeviceMsCache cache;
   DeviceSceneBuffers dev(runtime(), scene, nullptr);
-  cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 8, 8, "a");
-  scene.renderer.raymarch.msCache.closure = MsCacheClosure::Hg;
+  ASSERT_EQ(scene.renderer.raymarch.msCache.closure, MsCacheClosure::Linear);
   cache.refine(runtime(), dev, realtimeParams(scene, dev.scene).msCache, 8, 8, "a");
   EXPECT_EQ(cache.rebuilds(), 1);
   scene.renderer.raymarch.msCache.closure = MsCacheClosure::Camera;
@@ -572,7 +571,7 @@ std::vector<LitBoxCheck> checkLitBox(const std::string& reference, const std::st
     return R"({"resolution": [16, 16], "bounces": 64, "algorithm": "raymarch", "lightCache": {"resolution": 0},
       "raymarch": {"steps": )" + std::to_string(steps) + R"(, "shadowSteps": 4, "minTransmittance": 0,
       "multipleScattering": ")" + ms + R"(", "msCache": {"paths": )" + std::to_string(paths) +
-           R"(, "pathsPerLaunch": 512, )" + cache + unnamed + "}}}";
+           R"(, )" + cache + unnamed + "}}}";
   };
   auto realtime = [&](const std::string& renderer, uint32_t seed) {
     const RenderResult r = renderRealtime(runtime(), scene(renderer, seed), grid, 1, RenderOptions{});

@@ -99,7 +99,7 @@ inline RenderResult renderWith(Scene scene, const std::string& renderer, SceneGr
     scene.renderer.raymarch.msCache.paths = 8;
     scene.renderer.raymarch.areaLightPhase = AreaLightPhase::Exact;  // the phase over a rectangle's solid angle
     scene.renderer.raymarch.msCache.closure = renderer == "raymarch+ms-cache"
-                                                  ? MsCacheClosure::Hg       // the HG closure of the moments
+                                                  ? MsCacheClosure::Linear   // the moments' linear closure
                                                   : MsCacheClosure::Camera;  // the paths aimed at the camera
     if (renderer == "raymarch+ms-cache-view" || renderer == "raymarch+ms-cache-direct") {
       scene.renderer.raymarch.msCache.layout = MsCacheLayout::View;

@@ -105,13 +105,8 @@ TEST(MsCacheLookup, FirstMomentAndAZeroNode) {
               0.0f, 1e-9f);
 }
 
-// The HG closure on a field that is an HG lobe, L(w) = 4πR·p_HG(μ, w·b̂), whose moments are R and
-// b = 3Rμ·b̂: the lookup's closed form 4πR·p_HG(gμ, b̂·w_out) against the convolution
-// ∫ p_HG(g, w·w_out) L(w) dw summed on the host (double, convolvedHgField), forwards, sideways and
-// backwards, for g 0.8 and 0.9 and μ from a nearly isotropic field to a peaked one: within 0.01%
-// (float rounding in the lookup). The
-// linear closure on the same moments is off by far more backwards (clamped to 0 for μ ≥ 1/(3g))
-// and agrees only to first order in μ: at μ = 0.01 the two differ by < 0.1%.
+// A field that is an HG lobe, L(w) = 4πR·p_HG(μ, w·b̂), has the moments R and b = 3Rμ·b̂; its exact
+// in-scattering ∫ p_HG(g, w·w_out) L(w) dw is summed on the host (double, convolvedHgField).
 double hgPhase(double g, double mu) { return (1 - g * g) / (4 * M_PI * std::pow(1 + g * g - 2 * g * mu, 1.5)); }
 
 // ∫ p_HG(g, w·w_out)·4π·p_HG(μ, w·b̂) dw with b̂ = z and w_out in the xz plane: u = cos θ about b̂
@@ -138,23 +133,26 @@ double convolvedHgField(double g, double mu, double cosOut) {
   return simpson(-1, 1, fa, fm, fb, 2.0 / 6 * (fa + 4 * fm + fb), 40);
 }
 
-TEST(MsCacheLookup, HgClosureIsExactForAnHgField) {
+// The linear closure against the exact in-scattering of an HG field (the quadrature above): right to first
+// order in the field's anisotropy μ (|b|/3R 0.01: within 1e-3), clamped at 0 where a strongly one-sided
+// field's expansion would go negative (μ 0.6 seen backwards; the exact value is positive there).
+TEST(MsCacheLookup, LinearClosureIsFirstOrderInTheFieldsAnisotropyAndClamped) {
   const node_grid_params c = grid3();
   const vec3 dims = vec3_make(2, 2, 2), p = vec3_make(0.7f, 1.1f, 0.3f);
   for (double g : {0.8, 0.9})
-    for (double mu : {0.01, 0.3, 0.6}) {
+    for (double mu : {0.01, 0.6}) {
       const vec3 m = vec3_make(0, 0, float(3 * mu));  // b/R
       const std::vector<float> cache = cacheOf(c, [](vec3) { return 2.0f; }, m);
       for (double cosOut : {1.0, 0.5, 0.0, -0.7, -1.0}) {
         const vec3 w_out = vec3_make(float(std::sqrt(1 - cosOut * cosOut)), 0, float(cosOut));
         const double exact = 2.0 * convolvedHgField(g, mu, cosOut);
-        const float hg = ms_cache_lookup(&c, cache.data(), dims, p, float(g), MS_CACHE_CLOSURE_HG, w_out)
-                             .x;
         const float linear = ms_cache_lookup(&c, cache.data(), dims, p, float(g), MS_CACHE_CLOSURE_LINEAR, w_out)
                                  .x;
-        EXPECT_NEAR(hg, exact, 1e-4 * exact) << "g " << g << " mu " << mu << " cos " << cosOut;
-        if (mu == 0.01) EXPECT_NEAR(linear, hg, 1e-3 * hg) << "first order, g " << g << " cos " << cosOut;
-        if (mu == 0.6 && cosOut == -1.0) EXPECT_EQ(linear, 0.0f) << "the linear closure clamps backwards";
+        if (mu == 0.01) EXPECT_NEAR(linear, exact, 1e-3 * exact) << "first order, g " << g << " cos " << cosOut;
+        if (mu == 0.6 && cosOut == -1.0) {
+          EXPECT_EQ(linear, 0.0f) << "the linear closure clamps backwards";
+          EXPECT_GT(exact, 0.0);
+        }
       }
     }
 }
