@@ -25,8 +25,8 @@
  * truncation can dip below); exact for a field linear in w, but a field concentrated along its mean
  * direction (dense clouds at g 0.8–0.9, light scattered forwards a few times) has |b|/R near its bound 3,
  * so 1 − g·|b|/R ≈ 0 backwards (where front-lit clouds are seen from) and at most 1 + 3g forwards.
- (An HG lobe of the same R and b, which convolves with an HG phase function in closed form, was a closure
- * too: it won on one of eight scenes, lost on two, and went; bench/RESULTS.md.)
+ * (An HG lobe of the same R and b, which convolves with an HG phase function in closed form, was a
+ * closure too, removed when it did not win on enough scenes: bench/RESULTS.md.)
  * MS_CACHE_CLOSURE_CAMERA needs none: a node's paths draw their directions from the phase function about
  * w_c, the direction to the camera, so their mean radiance is the in-scattering towards the camera,
  * ∫ p(w·w_c) L(w) dw (importance sampled: p/pdf = 1). It is exact in direction up to w_c being the

@@ -8,10 +8,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <functional>
-#include <string_view>
 #include <vector>
 
+#include "cl/cl_runtime.h"
 #include "image/image.h"
 #include "render/device_ms_cache.h"
 #include "render/device_scene.h"
@@ -532,10 +531,10 @@ ImageRGB litBoxReference(const std::string& name, const std::string& json, uint3
       std::string(NARVAL_SOURCE_DIR) + "/tests/data/reference/" + name + "_seed" + std::to_string(seed) + ".exr";
   std::string key = json + " seed " + std::to_string(seed);
   if (grid.density) {
-    const std::string_view voxels(reinterpret_cast<const char*>(grid.density->data.data()),
-                                  grid.density->data.size() * sizeof(float));
+    const std::string voxels(reinterpret_cast<const char*>(grid.density->data.data()),
+                             grid.density->data.size() * sizeof(float));
     key += " grid " + std::to_string(grid.density->nx) + "x" + std::to_string(grid.density->ny) + "x" +
-           std::to_string(grid.density->nz) + " " + std::to_string(std::hash<std::string_view>{}(voxels));
+           std::to_string(grid.density->nz) + " " + std::to_string(fnv1a64(voxels));
   }
   if (std::getenv("NARVAL_WRITE_REFERENCE")) {
     Scene scene = sceneFromJson(json);
