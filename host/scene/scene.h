@@ -121,7 +121,7 @@ constexpr int kMsCacheTileAuto = 0;
 struct MsCacheSettings {
   MsCacheClosure closure = MsCacheClosure::Linear;
   MsCacheLayout layout = MsCacheLayout::View;
-  int resolution = 32;      // grid: cells on the medium box's longest axis (chosen on eight scenes: bench/RESULTS.md)
+  int resolution = 32;      // grid: cells on the medium box's longest axis (measured: bench/RESULTS.md)
   int tile = kMsCacheTileAuto;  // view: pixels per column side (auto: realtime_params.h, msCacheTile)
   int slices = 8;           // view: nodes per column
   // The lights' unscattered light: added by the march (false) or held by the cache with the rest

@@ -41,8 +41,8 @@
  * along each axis, keeps equal corners' value (the white furnace stays 1) and errs, like trilinear, at
  * second order in the node spacing. A node at 0 would pull the whole cell to 0, so R + floor is mixed,
  * floor = MS_CACHE_LOG_FLOOR × the cell's largest R, and taken off after. A linear mix of R and b, exact
- * for a field linear along each axis (which the geometric mean undershoots: the AM–GM inequality), won on
- * one scene of eight and lost on four, and was removed (bench/RESULTS.md).
+ * for a field linear along each axis (which the geometric mean undershoots: the AM–GM inequality), was
+ * an option too, removed when it did not win on enough scenes (bench/RESULTS.md).
  *
  * Direct (ms_cache_params.direct; closure camera or the view layout only): a node holds the whole
  * in-scattering towards the camera, unscattered light included, so the march has no light loop (no shadow

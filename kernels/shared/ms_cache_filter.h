@@ -39,7 +39,7 @@
 
 #define MS_VIEW_FILTER_EPSILON 1e-20f /* ε: keeps d² finite between noiseless nodes */
 #define MS_VIEW_FILTER_MAX_SLICES 64  /* msCache.slices' upper bound (the loader's) */
-/* k: no other value won on any of eight scenes, 1 and 4 lost on four and two (bench/RESULTS.md). */
+/* k, fixed: the value that measured best when it was a scene key (bench/RESULTS.md). */
 #define MS_VIEW_FILTER_TOLERANCE 2.0f
 
 /* The grey value of a node and the variance of that mean ("v_s"). */

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "shared/ms_cache.h"
@@ -139,22 +140,22 @@ double convolvedHgField(double g, double mu, double cosOut) {
 TEST(MsCacheLookup, LinearClosureIsFirstOrderInTheFieldsAnisotropyAndClamped) {
   const node_grid_params c = grid3();
   const vec3 dims = vec3_make(2, 2, 2), p = vec3_make(0.7f, 1.1f, 0.3f);
-  for (double g : {0.8, 0.9})
-    for (double mu : {0.01, 0.6}) {
-      const vec3 m = vec3_make(0, 0, float(3 * mu));  // b/R
-      const std::vector<float> cache = cacheOf(c, [](vec3) { return 2.0f; }, m);
-      for (double cosOut : {1.0, 0.5, 0.0, -0.7, -1.0}) {
-        const vec3 w_out = vec3_make(float(std::sqrt(1 - cosOut * cosOut)), 0, float(cosOut));
-        const double exact = 2.0 * convolvedHgField(g, mu, cosOut);
-        const float linear = ms_cache_lookup(&c, cache.data(), dims, p, float(g), MS_CACHE_CLOSURE_LINEAR, w_out)
-                                 .x;
-        if (mu == 0.01) EXPECT_NEAR(linear, exact, 1e-3 * exact) << "first order, g " << g << " cos " << cosOut;
-        if (mu == 0.6 && cosOut == -1.0) {
-          EXPECT_EQ(linear, 0.0f) << "the linear closure clamps backwards";
-          EXPECT_GT(exact, 0.0);
-        }
-      }
+  // The linear closure's value and the exact one, for g, the field's μ and the cosine of w_out with b̂.
+  auto closures = [&](double g, double mu, double cosOut) {
+    const std::vector<float> cache = cacheOf(c, [](vec3) { return 2.0f; }, vec3_make(0, 0, float(3 * mu)));  // b/R
+    const vec3 w_out = vec3_make(float(std::sqrt(1 - cosOut * cosOut)), 0, float(cosOut));
+    return std::make_pair(ms_cache_lookup(&c, cache.data(), dims, p, float(g), MS_CACHE_CLOSURE_LINEAR, w_out).x,
+                          2.0 * convolvedHgField(g, mu, cosOut));
+  };
+  for (double g : {0.8, 0.9}) {
+    for (double cosOut : {1.0, 0.5, 0.0, -0.7, -1.0}) {
+      const auto [linear, exact] = closures(g, 0.01, cosOut);
+      EXPECT_NEAR(linear, exact, 1e-3 * exact) << "first order, g " << g << " cos " << cosOut;
     }
+    const auto [linear, exact] = closures(g, 0.6, -1.0);
+    EXPECT_EQ(linear, 0.0f) << "the linear closure clamps backwards, g " << g;
+    EXPECT_GT(exact, 0.0);
+  }
 }
 
 }  // namespace
